@@ -1,0 +1,3 @@
+//! The `qem` command.
+#![forbid(unsafe_code)]
+fn main() {}

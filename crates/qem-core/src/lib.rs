@@ -1,0 +1,2 @@
+//! Quadric error metric algebra in f64.
+#![forbid(unsafe_code)]

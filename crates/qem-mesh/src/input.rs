@@ -1,0 +1,217 @@
+//! The library's input and output type, [`IndexedMesh`], and its validation.
+//!
+//! Everything that enters qem is first an `IndexedMesh`: a list of positions and a list
+//! of triangles that index into it. [`IndexedMesh::validate`] is the gate between
+//! untrusted data and the algorithm: after it succeeds every coordinate is finite and
+//! every index is in range, so later stages never have to check again.
+
+use std::fmt;
+
+/// The largest number of vertices or triangles qem accepts by default.
+///
+/// Why: the store needs about 200 bytes per triangle; 2^28 triangles is already
+/// ~50 GiB, far beyond the machines qem targets. A count above this is almost certainly
+/// a corrupt or hostile header, and refusing it keeps memory bounded.
+pub const MAX_ELEMENTS: usize = 1 << 28;
+
+/// A triangle mesh as plain arrays: positions and triangles indexing into them.
+///
+/// This is both what qem reads and what it writes. Nothing is assumed about it
+/// beyond what [`validate`](Self::validate) checks: it may be non-manifold, open,
+/// unwelded, in several parts, and contain degenerate or duplicate faces.
+///
+/// ```
+/// use qem_mesh::IndexedMesh;
+/// let mesh = IndexedMesh::new(
+///     vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+///     vec![[0, 1, 2]],
+/// );
+/// assert!(mesh.validate().is_ok());
+/// assert_eq!(mesh.triangle_count(), 1);
+/// ```
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct IndexedMesh {
+    /// Vertex positions in model units.
+    pub positions: Vec<[f64; 3]>,
+    /// Triangles as three indices into `positions`, counter-clockwise seen from outside.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// Why an [`IndexedMesh`] was refused, and where.
+#[derive(Clone, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum InputError {
+    /// The mesh has no triangles at all.
+    NoTriangles,
+    /// A coordinate is NaN or infinite.
+    NonFiniteCoordinate {
+        /// Index of the offending vertex.
+        vertex: usize,
+    },
+    /// A triangle refers to a vertex that does not exist.
+    IndexOutOfRange {
+        /// Index of the offending triangle.
+        face: usize,
+        /// The index it holds.
+        index: u32,
+        /// How many vertices the mesh has.
+        vertex_count: usize,
+    },
+    /// More vertices or triangles than [`MAX_ELEMENTS`].
+    TooLarge {
+        /// `"vertices"` or `"triangles"`.
+        what: &'static str,
+        /// How many there are.
+        count: usize,
+        /// The limit.
+        limit: usize,
+    },
+}
+
+impl fmt::Display for InputError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            InputError::NoTriangles => write!(f, "the mesh has no triangles"),
+            InputError::NonFiniteCoordinate { vertex } => {
+                write!(f, "vertex {vertex} has a non-finite coordinate")
+            }
+            InputError::IndexOutOfRange {
+                face,
+                index,
+                vertex_count,
+            } => write!(
+                f,
+                "face {face} refers to vertex {index}, but there are only {vertex_count} vertices"
+            ),
+            InputError::TooLarge { what, count, limit } => {
+                write!(f, "{count} {what} is more than the limit of {limit}")
+            }
+        }
+    }
+}
+
+impl std::error::Error for InputError {}
+
+impl IndexedMesh {
+    /// Makes a mesh from positions and triangles without checking them.
+    pub fn new(positions: Vec<[f64; 3]>, triangles: Vec<[u32; 3]>) -> Self {
+        Self {
+            positions,
+            triangles,
+        }
+    }
+
+    /// Number of vertices (referenced or not).
+    pub fn vertex_count(&self) -> usize {
+        self.positions.len()
+    }
+
+    /// Number of triangles (degenerate ones included).
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// Checks what every later stage relies on: at least one triangle, counts within
+    /// [`MAX_ELEMENTS`], finite coordinates, indices in range. Reports the first problem
+    /// found, vertices before faces.
+    pub fn validate(&self) -> Result<(), InputError> {
+        for (what, count) in [
+            ("vertices", self.positions.len()),
+            ("triangles", self.triangles.len()),
+        ] {
+            if count > MAX_ELEMENTS {
+                return Err(InputError::TooLarge {
+                    what,
+                    count,
+                    limit: MAX_ELEMENTS,
+                });
+            }
+        }
+        if self.triangles.is_empty() {
+            return Err(InputError::NoTriangles);
+        }
+        if let Some(vertex) = self
+            .positions
+            .iter()
+            .position(|p| !p.iter().all(|c| c.is_finite()))
+        {
+            return Err(InputError::NonFiniteCoordinate { vertex });
+        }
+        let vertex_count = self.positions.len();
+        for (face, tri) in self.triangles.iter().enumerate() {
+            for &index in tri {
+                if index as usize >= vertex_count {
+                    return Err(InputError::IndexOutOfRange {
+                        face,
+                        index,
+                        vertex_count,
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The axis-aligned bounding box of all positions as `(min, max)`, or `None` when
+    /// there are no positions.
+    pub fn bounding_box(&self) -> Option<([f64; 3], [f64; 3])> {
+        let first = *self.positions.first()?;
+        let mut lo = first;
+        let mut hi = first;
+        for p in &self.positions {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        Some((lo, hi))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tri() -> IndexedMesh {
+        IndexedMesh::new(
+            vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            vec![[0, 1, 2]],
+        )
+    }
+
+    #[test]
+    fn empty_mesh_has_no_triangles() {
+        let err = IndexedMesh::default().validate().unwrap_err();
+        assert_eq!(err, InputError::NoTriangles);
+        assert_eq!(err.to_string(), "the mesh has no triangles");
+    }
+
+    #[test]
+    fn nan_coordinate_names_the_vertex() {
+        let mut m = tri();
+        m.positions[2][1] = f64::NAN;
+        let err = m.validate().unwrap_err();
+        assert_eq!(err, InputError::NonFiniteCoordinate { vertex: 2 });
+        assert_eq!(err.to_string(), "vertex 2 has a non-finite coordinate");
+    }
+
+    #[test]
+    fn out_of_range_index_names_the_face() {
+        let mut m = tri();
+        m.triangles.push([0, 1, 7]);
+        let err = m.validate().unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "face 1 refers to vertex 7, but there are only 3 vertices"
+        );
+    }
+
+    #[test]
+    fn bounding_box_spans_positions() {
+        assert_eq!(
+            tri().bounding_box(),
+            Some(([0.0, 0.0, 0.0], [1.0, 1.0, 0.0]))
+        );
+        assert_eq!(IndexedMesh::default().bounding_box(), None);
+    }
+}
