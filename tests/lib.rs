@@ -1,2 +1,8 @@
-//! Workspace-level integration tests for qem; the tests live in `tests/tests/`.
+//! Workspace-level integration tests for qem, and the checks behind the fuzz targets.
+//!
+//! Every cargo-fuzz target in `fuzz/` is one call into a function of [`fuzz_checks`], so
+//! the same checks run in `cargo test` (which replays the committed fuzz corpora and
+//! crash reproducers, see `tests/fuzz_replay.rs`) without cargo-fuzz installed.
 #![forbid(unsafe_code)]
+
+pub mod fuzz_checks;

@@ -1,0 +1,161 @@
+//! Property tests of the quadric algebra and of placement.
+
+use proptest::prelude::*;
+use qem_core::{minimize, optimal_placement, DVec3, Quadric};
+
+/// A plane with unit normal, offset and weight, kept explicitly for brute force.
+#[derive(Clone, Copy, Debug)]
+struct Plane {
+    normal: DVec3,
+    d: f64,
+    weight: f64,
+}
+
+impl Plane {
+    fn squared_distance(&self, p: DVec3) -> f64 {
+        let s = self.normal.dot(p) + self.d;
+        s * s
+    }
+    fn quadric(&self) -> Quadric {
+        Quadric::from_plane(self.normal, self.d) * self.weight
+    }
+}
+
+fn point() -> impl Strategy<Value = DVec3> {
+    (-2.0..2.0f64, -2.0..2.0f64, -2.0..2.0f64).prop_map(|(x, y, z)| DVec3::new(x, y, z))
+}
+
+fn plane() -> impl Strategy<Value = Plane> {
+    (point(), -2.0..2.0f64, 0.01..10.0f64)
+        .prop_filter("normal must be normalisable", |(n, _, _)| n.length() > 1e-3)
+        .prop_map(|(n, d, weight)| Plane {
+            normal: n.normalize(),
+            d,
+            weight,
+        })
+}
+
+fn planes() -> impl Strategy<Value = Vec<Plane>> {
+    prop::collection::vec(plane(), 1..12)
+}
+
+fn sum(planes: &[Plane]) -> Quadric {
+    planes.iter().map(Plane::quadric).sum()
+}
+
+fn brute_force(planes: &[Plane], p: DVec3) -> f64 {
+    planes
+        .iter()
+        .map(|pl| pl.weight * pl.squared_distance(p))
+        .sum()
+}
+
+/// Rounding allowance for a sum of `n` terms of the given magnitude.
+fn rounding(magnitude: f64) -> f64 {
+    1e-12 * (1.0 + magnitude)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(512))]
+
+    #[test]
+    fn evaluate_is_non_negative(ps in planes(), p in point()) {
+        let q = sum(&ps);
+        let scale = q.magnitude() * (1.0 + p.length_squared());
+        prop_assert!(q.evaluate(p) >= -rounding(scale));
+    }
+
+    #[test]
+    fn evaluate_is_additive(a in planes(), b in planes(), p in point()) {
+        let (qa, qb) = (sum(&a), sum(&b));
+        let lhs = (qa + qb).evaluate(p);
+        let rhs = qa.evaluate(p) + qb.evaluate(p);
+        let scale = (qa.magnitude() + qb.magnitude()) * (1.0 + p.length_squared());
+        prop_assert!((lhs - rhs).abs() <= rounding(scale));
+    }
+
+    #[test]
+    fn from_plane_is_squared_distance(pl in plane(), p in point()) {
+        let q = Quadric::from_plane(pl.normal, pl.d);
+        let expected = pl.squared_distance(p);
+        prop_assert!((q.evaluate(p) - expected).abs() <= 1e-12 * (1.0 + expected));
+    }
+
+    /// The reference for "exact" later: a quadric of planes equals the brute-force sum
+    /// of weighted squared distances over the explicit plane list, to 1e-9 relative.
+    #[test]
+    fn quadric_of_planes_equals_brute_force_sum(ps in planes(), p in point()) {
+        let q = sum(&ps);
+        let exact = brute_force(&ps, p);
+        let scale: f64 = ps.iter().map(|pl| pl.weight * (1.0 + pl.d.abs() + p.length()).powi(2)).sum();
+        prop_assert!((q.evaluate(p) - exact).abs() <= 1e-9 * exact.max(1e-3 * scale),
+            "quadric {} vs brute force {}", q.evaluate(p), exact);
+    }
+
+    #[test]
+    fn triangle_quadric_equals_area_times_squared_distance(
+        a in point(), b in point(), c in point(), p in point()
+    ) {
+        let cross = (b - a).cross(c - a);
+        prop_assume!(cross.length() > 1e-6);
+        let n = cross.normalize();
+        let area = 0.5 * cross.length();
+        let expected = area * (n.dot(p - a)).powi(2);
+        let q = Quadric::from_triangle(a, b, c);
+        prop_assert!((q.evaluate(p) - expected).abs() <= 1e-9 * (1.0 + expected) * (1.0 + area));
+    }
+
+    #[test]
+    fn placement_never_costs_more_than_ends_and_midpoint(ps in planes(), a in point(), b in point()) {
+        let q = sum(&ps);
+        let placed = optimal_placement(&q, a, b);
+        prop_assert!(placed.position.is_finite());
+        prop_assert!(placed.cost >= 0.0);
+        for candidate in [a, b, a * 0.5 + b * 0.5] {
+            prop_assert!(placed.cost <= q.evaluate(candidate).max(0.0),
+                "{:?} costs more than {candidate}", placed);
+        }
+    }
+
+    #[test]
+    fn gradient_vanishes_at_a_unique_minimum(ps in prop::collection::vec(plane(), 3..12)) {
+        let q = sum(&ps);
+        if let Some(x) = minimize(&q) {
+            let g = q.gradient(x);
+            let scale = q.magnitude() * (1.0 + x.length());
+            prop_assert!(g.length() <= 1e-6 * scale, "gradient {g} at {x}");
+            // And it is a minimum: nearby points cost no less.
+            for dir in [DVec3::X, DVec3::Y, DVec3::Z] {
+                let here = q.evaluate(x);
+                prop_assert!(q.evaluate(x + 1e-3 * dir) >= here - rounding(scale));
+                prop_assert!(q.evaluate(x - 1e-3 * dir) >= here - rounding(scale));
+            }
+        }
+    }
+
+    #[test]
+    fn translation_is_equivariant(ps in planes(), t in point(), p in point()) {
+        let q = sum(&ps);
+        let moved = q.translated(t);
+        let scale = q.magnitude() * (1.0 + (p + t).length_squared());
+        prop_assert!((moved.evaluate(p + t) - q.evaluate(p)).abs() <= 1e-10 * (1.0 + scale));
+        // The planes moved by t, built from scratch, give the same quadric.
+        let shifted: Vec<Plane> = ps.iter().map(|pl| Plane { d: pl.d - pl.normal.dot(t), ..*pl }).collect();
+        let direct = sum(&shifted);
+        for (x, y) in moved.entries().iter().zip(direct.entries()) {
+            prop_assert!((x - y).abs() <= 1e-10 * (1.0 + scale));
+        }
+        if let (Some(x0), Some(x1)) = (minimize(&q), minimize(&moved)) {
+            prop_assert!((x1 - (x0 + t)).length() <= 1e-6 * (1.0 + x0.length()));
+        }
+    }
+
+    #[test]
+    fn finite_entries_give_finite_placement(
+        e in prop::array::uniform10(-1e6..1e6f64), a in point(), b in point()
+    ) {
+        let placed = optimal_placement(&Quadric::from_entries(e), a, b);
+        prop_assert!(placed.position.is_finite());
+        prop_assert!(!placed.cost.is_nan());
+    }
+}
