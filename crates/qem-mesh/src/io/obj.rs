@@ -80,7 +80,12 @@ fn keyword(line: &[u8]) -> (&[u8], &[u8]) {
 /// The scan described in the module docs. Returns the byte ranges of lines to blank
 /// out before `tobj` sees the text: comments that are not UTF-8 (tobj would refuse the
 /// whole file) and bare `usemtl` lines (tobj refuses them; they mean "no material").
-fn prescan(bytes: &[u8]) -> Result<Vec<std::ops::Range<usize>>, ReadError> {
+///
+/// With `detailed == false` only what guards `tobj` is checked (text, face indices:
+/// not 0, not before the start, not absurdly large); the detailed scan also checks the
+/// numbers of `v`/`vt`/`vn` lines and indices against the file's totals, and runs only
+/// when `tobj` or validation has refused the data, to say where.
+fn prescan(bytes: &[u8], detailed: bool) -> Result<Vec<std::ops::Range<usize>>, ReadError> {
     if let Some(other) = sniff(bytes).filter(|&s| s != "an OBJ file") {
         return Err(ReadError::not_this_format(
             Format::Obj,
@@ -88,8 +93,16 @@ fn prescan(bytes: &[u8]) -> Result<Vec<std::ops::Range<usize>>, ReadError> {
             "the content is not OBJ text",
         ));
     }
-    let mut total = Counts::default();
-    for (_, line) in text::lines(bytes) {
+    // No list can have more elements than the file has lines.
+    let mut total = Counts {
+        v: bytes.len(),
+        vt: bytes.len(),
+        vn: bytes.len(),
+    };
+    if detailed {
+        total = Counts::default();
+    }
+    for (_, line) in text::lines(bytes).filter(|_| detailed) {
         match keyword(line).0 {
             b"v" => total.v += 1,
             b"vt" => total.vt += 1,
@@ -100,18 +113,23 @@ fn prescan(bytes: &[u8]) -> Result<Vec<std::ops::Range<usize>>, ReadError> {
     let mut so_far = Counts::default();
     let mut faces = 0usize;
     let mut blank = Vec::new();
+    // One check of the whole text is much cheaper than one per line.
+    let all_utf8 = std::str::from_utf8(bytes).is_ok();
     for (no, line) in text::lines(bytes) {
         let at = Location::Line(no);
         let (key, rest) = keyword(line);
         // Offset of the line in `bytes` (both are views of the same buffer).
         let start = line.as_ptr() as usize - bytes.as_ptr() as usize;
         if key.first() == Some(&b'#') {
-            if std::str::from_utf8(line).is_err() {
+            if !all_utf8 && std::str::from_utf8(line).is_err() {
                 blank.push(start..start + line.len());
             }
             continue;
         }
-        if let Err(e) = std::str::from_utf8(line) {
+        if let Some(e) = (!all_utf8)
+            .then(|| std::str::from_utf8(line).err())
+            .flatten()
+        {
             return Err(ReadError::malformed(
                 at,
                 format!(
@@ -120,23 +138,29 @@ fn prescan(bytes: &[u8]) -> Result<Vec<std::ops::Range<usize>>, ReadError> {
                 ),
             ));
         }
-        let numbers = |n: usize, what: &str, index: usize| -> Result<Vec<f64>, ReadError> {
-            let mut vals = Vec::with_capacity(n);
-            for tok in words(rest).take(n) {
-                let x = parse_f64(tok).ok_or_else(|| {
+        let numbers = |n: usize, what: &str, index: usize| -> Result<[f64; 3], ReadError> {
+            let mut vals = [0.0; 3];
+            let mut found = 0;
+            for (slot, tok) in vals.iter_mut().zip(words(rest)).take(n) {
+                *slot = parse_f64(tok).ok_or_else(|| {
                     ReadError::malformed(at, format!("{what} {index}: bad number {}", show(tok)))
                 })?;
-                vals.push(x);
+                found += 1;
             }
-            if vals.len() < n {
+            if found < n {
                 return Err(ReadError::malformed(
                     at,
-                    format!("{what} {index}: expected {n} numbers, found {}", vals.len()),
+                    format!("{what} {index}: expected {n} numbers, found {found}"),
                 ));
             }
             Ok(vals)
         };
         match key {
+            b"v" | b"vt" | b"vn" if !detailed => match key {
+                b"v" => so_far.v += 1,
+                b"vt" => so_far.vt += 1,
+                _ => so_far.vn += 1,
+            },
             b"v" => {
                 let v = so_far.v;
                 let p = numbers(3, "vertex", v)?;
@@ -146,10 +170,12 @@ fn prescan(bytes: &[u8]) -> Result<Vec<std::ops::Range<usize>>, ReadError> {
                         InputError::NonFiniteCoordinate { vertex: v },
                     ));
                 }
-                let extra: Vec<&[u8]> = words(rest).skip(3).collect();
-                match extra.as_slice() {
-                    [] | [_, _, _] => {}
-                    [w] => {
+                let mut extra = words(rest).skip(3);
+                let first = extra.next();
+                let n_extra = usize::from(first.is_some()) + extra.count();
+                match (n_extra, first) {
+                    (0 | 3, _) => {}
+                    (_, Some(w)) if n_extra == 1 => {
                         if parse_f64(w).map_or(true, |w| w == 0.0 || !w.is_finite()) {
                             return Err(ReadError::malformed(
                                 at,
@@ -163,7 +189,7 @@ fn prescan(bytes: &[u8]) -> Result<Vec<std::ops::Range<usize>>, ReadError> {
                             format!(
                                 "vertex {v}: expected 3 coordinates, optionally followed by \
                                  a weight or 3 colour values; found {} numbers",
-                                3 + extra.len()
+                                3 + n_extra
                             ),
                         ))
                     }
@@ -179,7 +205,9 @@ fn prescan(bytes: &[u8]) -> Result<Vec<std::ops::Range<usize>>, ReadError> {
                 so_far.vn += 1;
             }
             b"f" | b"l" => {
-                for corner in words(rest) {
+                // Nearly every face passes the quick check; the rest get the full one.
+                let quick = !detailed && plain_positive_corners(rest);
+                for corner in words(rest).filter(|_| !quick) {
                     check_corner(corner, faces, so_far, total, at)?;
                 }
                 faces += usize::from(key == b"f");
@@ -191,6 +219,39 @@ fn prescan(bytes: &[u8]) -> Result<Vec<std::ops::Range<usize>>, ReadError> {
     Ok(blank)
 }
 
+/// Whether a face line's corners are all `a[/[b][/c]]` with positive indices of at
+/// most 15 digits (which cannot overflow anything), in one pass over the bytes.
+fn plain_positive_corners(rest: &[u8]) -> bool {
+    let (mut digits, mut nonzero, mut slashes) = (0u32, false, 0u32);
+    for &b in rest {
+        match b {
+            b'0'..=b'9' => {
+                digits += 1;
+                nonzero |= b != b'0';
+                if digits > 15 {
+                    return false;
+                }
+            }
+            b'/' => {
+                // A corner cannot start with "/", an index cannot be 0, at most 2 "/".
+                if (slashes == 0 && digits == 0) || (digits > 0 && !nonzero) || slashes == 2 {
+                    return false;
+                }
+                slashes += 1;
+                (digits, nonzero) = (0, false);
+            }
+            b' ' | b'\t' | b'\r' => {
+                if digits > 0 && !nonzero {
+                    return false;
+                }
+                (digits, nonzero, slashes) = (0, false, 0);
+            }
+            _ => return false,
+        }
+    }
+    digits == 0 || nonzero
+}
+
 /// Checks one `v[/vt[/vn]]` face corner.
 fn check_corner(
     corner: &[u8],
@@ -199,13 +260,12 @@ fn check_corner(
     total: Counts,
     at: Location,
 ) -> Result<(), ReadError> {
-    let parts: Vec<&[u8]> = corner.split(|&b| b == b'/').collect();
-    if parts.len() > 3 || parts[0].is_empty() {
-        return Err(ReadError::malformed(
-            at,
-            format!("face {face}: bad corner {}", show(corner)),
-        ));
+    let bad_corner =
+        || ReadError::malformed(at, format!("face {face}: bad corner {}", show(corner)));
+    if corner.iter().filter(|&&b| b == b'/').count() > 2 || corner.first() == Some(&b'/') {
+        return Err(bad_corner());
     }
+    let parts = corner.split(|&b| b == b'/');
     let lists = [
         ("vertex", "vertices", so_far.v, total.v),
         (
@@ -216,7 +276,7 @@ fn check_corner(
         ),
         ("normal", "normals", so_far.vn, total.vn),
     ];
-    for (part, (what, whats, before, all)) in parts.iter().zip(lists) {
+    for (part, (what, whats, before, all)) in parts.zip(lists) {
         if part.is_empty() {
             continue;
         }
@@ -253,7 +313,8 @@ pub(crate) fn read(bytes: &[u8]) -> Result<LoadedMesh, ReadError> {
     // long faces); join them first, keeping byte offsets, and remember where.
     let (joined, joins) = join_continuations(bytes);
     let source: &[u8] = joined.as_deref().unwrap_or(bytes);
-    let blank = prescan(source).map_err(|e| physical_line(e, source, &joins))?;
+    let located = |e| physical_line(e, source, &joins);
+    let blank = prescan(source, false).map_err(located)?;
     let owned;
     let text: &[u8] = if blank.is_empty() {
         source
@@ -276,15 +337,25 @@ pub(crate) fn read(bytes: &[u8]) -> Result<LoadedMesh, ReadError> {
     };
     let mut reader = text;
     let (models, _materials) =
-        tobj::load_obj_buf(&mut reader, &options, |_| Ok(Default::default())).map_err(|e| {
-            ReadError::new(
-                super::ReadErrorKind::Malformed {
-                    detail: format!("OBJ rejected by tobj: {e} (line not located)"),
-                },
-                None,
-            )
-        })?;
-    Ok(assemble(&models))
+        match tobj::load_obj_buf(&mut reader, &options, |_| Ok(Default::default())) {
+            Ok(r) => r,
+            Err(e) => {
+                prescan(source, true).map_err(located)?;
+                return Err(ReadError::new(
+                    super::ReadErrorKind::Malformed {
+                        detail: format!("OBJ rejected by tobj: {e} (line not located)"),
+                    },
+                    None,
+                ));
+            }
+        };
+    let loaded = assemble(&models);
+    if let Err(e) = loaded.mesh.validate() {
+        // Say where, when the detailed scan can (e.g. a non-finite coordinate).
+        prescan(source, true).map_err(located)?;
+        return Err(ReadError::mesh(None, e));
+    }
+    Ok(loaded)
 }
 
 /// Replaces every `\\` that ends a line, and the line break after it, by spaces.

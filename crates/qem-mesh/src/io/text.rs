@@ -125,9 +125,30 @@ pub(crate) fn parse_f64(tok: &[u8]) -> Option<f64> {
     std::str::from_utf8(tok).ok()?.parse().ok()
 }
 
-/// Parses a decimal integer with an optional sign.
+/// Parses a decimal integer with an optional sign (no allocation, overflow checked).
 pub(crate) fn parse_i64(tok: &[u8]) -> Option<i64> {
-    std::str::from_utf8(tok).ok()?.parse().ok()
+    let (neg, digits) = match tok.split_first()? {
+        (b'-', rest) => (true, rest),
+        (b'+', rest) => (false, rest),
+        _ => (false, tok),
+    };
+    if digits.is_empty() {
+        return None;
+    }
+    let mut v: i64 = 0;
+    for &d in digits {
+        if !d.is_ascii_digit() {
+            return None;
+        }
+        let d = i64::from(d - b'0');
+        // Accumulate negatively so that i64::MIN parses too.
+        v = v.checked_mul(10)?.checked_sub(d)?;
+    }
+    if neg {
+        Some(v)
+    } else {
+        v.checked_neg()
+    }
 }
 
 /// A token as shown in an error message: lossy UTF-8, at most 40 characters.
@@ -156,6 +177,15 @@ mod tests {
         let v: Vec<_> = lines(b"a\r\nb\n\nc").collect();
         assert_eq!(v, vec![(1, &b"a"[..]), (2, b"b"), (3, b""), (4, b"c")]);
         assert_eq!(lines(b"a\n").count(), 1);
+    }
+
+    #[test]
+    fn parse_i64_edges() {
+        assert_eq!(parse_i64(b"-9223372036854775808"), Some(i64::MIN));
+        assert_eq!(parse_i64(b"9223372036854775808"), None);
+        assert_eq!(parse_i64(b"+12"), Some(12));
+        assert_eq!(parse_i64(b"-"), None);
+        assert_eq!(parse_i64(b"1x"), None);
     }
 
     #[test]
