@@ -3,6 +3,7 @@
 //! its directory, or keep it at `../shared/corpus` beside the checkout; the tests skip
 //! with a message when it is absent.
 #![cfg(feature = "io")]
+#![allow(clippy::unwrap_used)]
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};

@@ -1,5 +1,6 @@
 //! Malformed input, round trips and atomic writes of `qem_mesh::io`.
 #![cfg(feature = "io")]
+#![allow(clippy::unwrap_used)]
 
 use std::io::Write;
 use std::path::Path;
@@ -31,7 +32,7 @@ fn quad() -> IndexedMesh {
             [0.0, 0.0, 0.0],
             [1.0, 0.0, 0.0],
             [1.0, 1.0 / 3.0, 0.0],
-            [0.1, 1e-300, 12345.678_9],
+            [0.1, 1e-300, 12_345.678_9],
         ],
         vec![[0, 1, 2], [0, 2, 3]],
     )
@@ -366,8 +367,8 @@ fn round_trips_every_format_plain_and_gzipped() {
             if f == Format::Stl {
                 assert_eq!(back.triangles, vec![[0, 1, 2], [3, 4, 5]]);
                 for (t, tri) in m.triangles.iter().enumerate() {
-                    for k in 0..3 {
-                        let want = m.positions[tri[k] as usize].map(|c| f64::from(c as f32));
+                    for (k, &i) in tri.iter().enumerate() {
+                        let want = m.positions[i as usize].map(|c| f64::from(c as f32));
                         assert_eq!(back.positions[3 * t + k], want);
                     }
                 }

@@ -328,6 +328,8 @@ pub(crate) fn read(bytes: &[u8]) -> Result<LoadedMesh, ReadError> {
         owned = copy;
         &owned
     };
+    // `..Default::default()` covers fields that tobj's optional features add.
+    #[allow(clippy::needless_update)]
     let options = tobj::LoadOptions {
         single_index: false,
         triangulate: true,
