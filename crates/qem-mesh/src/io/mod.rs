@@ -1,0 +1,422 @@
+//! Mesh file readers and writers: OBJ, PLY, STL and OFF, each optionally gzipped.
+//!
+//! # Reading
+//! [`read_path`] picks the format from the file name ([`Format::from_path`]: the
+//! extension, case-insensitive, after stripping a trailing `.gz`), reads the whole file
+//! into memory, decompresses it if it starts with the gzip magic bytes, and parses it
+//! with [`read_bytes`]. `read_bytes` is a pure function from arbitrary bytes to a mesh
+//! or an error: it never panics and never allocates more than the input can justify.
+//!
+//! Polygons are fan-triangulated from their first corner. Vertices are never welded
+//! or removed by the PLY, STL and OFF readers (an STL facet gives three new vertices);
+//! see [`obj`] for what the OBJ reader (built on `tobj`) does to vertex order.
+//!
+//! **What `read_*` checks.** The result is a mesh that passes
+//! [`IndexedMesh::validate`]: at least one triangle, counts within
+//! [`MAX_ELEMENTS`](crate::MAX_ELEMENTS), finite coordinates, indices in range. Where
+//! possible these are reported during parsing with the line or byte where they occur.
+//! Nothing else is checked or repaired: degenerate, duplicate and non-manifold faces
+//! pass through to the cleaning stage.
+//!
+//! **Bounded memory.** Counts above `MAX_ELEMENTS` are refused; no buffer is reserved
+//! beyond what the remaining bytes could hold; gzip output is capped at
+//! [`GZIP_MAX_RATIO`] times the compressed size and at [`GZIP_MAX_BYTES`].
+//!
+//! # Writing
+//! [`write_to`] writes any format to a `Write`; [`write_path`] writes a file
+//! atomically (a temporary file in the same directory, then a rename), gzipped when the
+//! name ends in `.gz`. OBJ and OFF are text with coordinates written in Rust's shortest
+//! round-trip form, PLY is `binary_little_endian` with `double` coordinates: all three
+//! read back bit-exact. STL is binary with `float32` coordinates (the format has no
+//! other choice) and facet normals computed from the triangles.
+//!
+//! ```
+//! use qem_mesh::io::{read_bytes, write_to, Format};
+//! use qem_mesh::IndexedMesh;
+//!
+//! let mesh = IndexedMesh::new(
+//!     vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.1]],
+//!     vec![[0, 1, 2]],
+//! );
+//! let mut bytes = Vec::new();
+//! write_to(&mut bytes, &mesh, Format::Ply).unwrap();
+//! let loaded = read_bytes(&bytes, Format::Ply).unwrap();
+//! assert_eq!(loaded.mesh, mesh);
+//! ```
+
+mod error;
+pub mod obj;
+mod off;
+mod ply;
+mod stl;
+mod text;
+
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+
+pub use error::{IoError, Location, ReadError, ReadErrorKind};
+pub use obj::ObjAttributes;
+
+use crate::IndexedMesh;
+
+/// The extensions [`Format::from_path`] accepts, as shown in error messages.
+pub const SUPPORTED_EXTENSIONS: &str = ".obj, .ply, .stl, .off (each optionally followed by .gz)";
+
+/// Decompressed gzip data may be at most this many times the compressed size.
+///
+/// Why: deflate cannot expand more than about 1032:1, so anything above this is not a
+/// valid stream, and refusing it bounds memory on a hostile "zip bomb".
+pub const GZIP_MAX_RATIO: u64 = 1100;
+
+/// Decompressed gzip data may be at most this many bytes (4 GiB).
+pub const GZIP_MAX_BYTES: u64 = 4 << 30;
+
+/// A mesh file format.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Format {
+    /// Wavefront OBJ (text).
+    Obj,
+    /// Stanford PLY (ascii, binary little or big endian).
+    Ply,
+    /// STL (ascii or binary).
+    Stl,
+    /// Object File Format (text; `OFF`, `COFF`, `NOFF`, `STOFF`... headers).
+    Off,
+}
+
+impl Format {
+    /// All formats, in the order of [`SUPPORTED_EXTENSIONS`].
+    pub const ALL: [Format; 4] = [Format::Obj, Format::Ply, Format::Stl, Format::Off];
+
+    /// The usual extension, lower case, without the dot.
+    pub fn extension(self) -> &'static str {
+        match self {
+            Format::Obj => "obj",
+            Format::Ply => "ply",
+            Format::Stl => "stl",
+            Format::Off => "off",
+        }
+    }
+
+    /// The format's name with an article, for messages: "an OBJ", "a PLY".
+    fn article_name(self) -> &'static str {
+        match self {
+            Format::Obj => "an OBJ",
+            Format::Ply => "a PLY",
+            Format::Stl => "an STL",
+            Format::Off => "an OFF",
+        }
+    }
+
+    /// The format for an extension (without the dot, case-insensitive).
+    pub fn from_extension(ext: &str) -> Option<Format> {
+        Format::ALL
+            .into_iter()
+            .find(|f| f.extension().eq_ignore_ascii_case(ext))
+    }
+
+    /// The format named by a path's extension, after stripping a trailing `.gz`
+    /// (case-insensitive). An unknown or missing extension is an error that lists the
+    /// supported ones.
+    ///
+    /// ```
+    /// use qem_mesh::io::Format;
+    /// use std::path::Path;
+    /// assert_eq!(Format::from_path(Path::new("bunny.PLY.gz")).unwrap(), Format::Ply);
+    /// let err = Format::from_path(Path::new("bunny.js")).unwrap_err();
+    /// assert!(err.to_string().starts_with("unsupported file extension \".js\""));
+    /// ```
+    pub fn from_path(path: &Path) -> Result<Format, ReadError> {
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let stem = strip_gz(&name).unwrap_or(&name);
+        let ext = Path::new(stem)
+            .extension()
+            .map(|e| e.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        Format::from_extension(&ext).ok_or_else(|| {
+            ReadError::new(ReadErrorKind::UnsupportedExtension { extension: ext }, None)
+        })
+    }
+}
+
+/// `name` without a trailing `.gz` (any case), or `None` if it has none.
+fn strip_gz(name: &str) -> Option<&str> {
+    let cut = name.len().checked_sub(3)?;
+    let (stem, tail) = (name.get(..cut)?, name.get(cut..)?);
+    tail.eq_ignore_ascii_case(".gz").then_some(stem)
+}
+
+/// A mesh as read from a file, with what the file held beside it.
+#[derive(Clone, Debug, Default, PartialEq)]
+#[non_exhaustive]
+pub struct LoadedMesh {
+    /// The triangles and positions; passes [`IndexedMesh::validate`].
+    pub mesh: IndexedMesh,
+    /// Texture coordinates and normals of an OBJ file (`None` for other formats).
+    pub obj: Option<ObjAttributes>,
+}
+
+/// Reads mesh data in `format` from memory. Gzip data (magic bytes `1f 8b`) is
+/// decompressed first, whatever the format.
+///
+/// Never panics; the result passes [`IndexedMesh::validate`] (see the
+/// [module docs](self) for what that covers).
+///
+/// ```
+/// use qem_mesh::io::{read_bytes, Format};
+/// let off = b"OFF\n4 1 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n";
+/// let loaded = read_bytes(off, Format::Off).unwrap();
+/// assert_eq!(loaded.mesh.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+///
+/// let err = read_bytes(b"OFF\n3 1 0\n0 0 0\n1 0 0\n", Format::Off).unwrap_err();
+/// assert_eq!(err.to_string(), "line 4: unexpected end of file after 2 of 3 vertices");
+/// ```
+pub fn read_bytes(bytes: &[u8], format: Format) -> Result<LoadedMesh, ReadError> {
+    if is_gzip(bytes) {
+        let data = gunzip(bytes)?;
+        return read_plain(&data, format);
+    }
+    read_plain(bytes, format)
+}
+
+fn read_plain(bytes: &[u8], format: Format) -> Result<LoadedMesh, ReadError> {
+    if bytes.is_empty() {
+        return Err(ReadError::new(ReadErrorKind::Empty, None));
+    }
+    let loaded = match format {
+        Format::Obj => obj::read(bytes)?,
+        Format::Ply => LoadedMesh {
+            mesh: ply::read(bytes)?,
+            obj: None,
+        },
+        Format::Stl => LoadedMesh {
+            mesh: stl::read(bytes)?,
+            obj: None,
+        },
+        Format::Off => LoadedMesh {
+            mesh: off::read(bytes)?,
+            obj: None,
+        },
+    };
+    // The parsers report most problems with a place; this is the safety net that makes
+    // the documented guarantee hold whatever they missed.
+    loaded
+        .mesh
+        .validate()
+        .map_err(|e| ReadError::mesh(None, e))?;
+    Ok(loaded)
+}
+
+fn is_gzip(bytes: &[u8]) -> bool {
+    bytes.starts_with(&[0x1f, 0x8b])
+}
+
+/// Decompresses gzip data (all members), refusing more than the documented caps.
+fn gunzip(bytes: &[u8]) -> Result<Vec<u8>, ReadError> {
+    let len = bytes.len() as u64;
+    let limit = len
+        .saturating_mul(GZIP_MAX_RATIO)
+        .saturating_add(1 << 16)
+        .min(GZIP_MAX_BYTES);
+    let mut out = Vec::new();
+    let mut decoder = flate2::read::MultiGzDecoder::new(bytes).take(limit.saturating_add(1));
+    decoder.read_to_end(&mut out).map_err(|e| {
+        ReadError::new(
+            ReadErrorKind::Gzip {
+                detail: format!("corrupt data after {} decompressed bytes: {e}", out.len()),
+            },
+            None,
+        )
+    })?;
+    if out.len() as u64 > limit {
+        return Err(ReadError::new(
+            ReadErrorKind::Gzip {
+                detail: format!(
+                    "decompresses to more than {limit} bytes \
+                     ({GZIP_MAX_RATIO}x the compressed size, at most {GZIP_MAX_BYTES})"
+                ),
+            },
+            None,
+        ));
+    }
+    Ok(out)
+}
+
+/// Reads a mesh file; the format comes from the name ([`Format::from_path`]),
+/// gzip is detected by content. Errors name the file.
+///
+/// ```
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// use qem_mesh::io::{read_path, write_path};
+/// use qem_mesh::IndexedMesh;
+/// let dir = tempfile::tempdir()?;
+/// let path = dir.path().join("tri.stl.gz");
+/// let mesh = IndexedMesh::new(vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], vec![[0, 1, 2]]);
+/// write_path(&path, &mesh)?;
+/// assert_eq!(read_path(&path)?.mesh, mesh);
+///
+/// let err = read_path(&dir.path().join("missing.obj")).unwrap_err();
+/// assert!(err.to_string().contains("missing.obj: cannot read: "));
+/// # Ok(()) }
+/// ```
+pub fn read_path(path: &Path) -> Result<LoadedMesh, IoError> {
+    let read_err = |source| IoError::Read {
+        path: path.to_path_buf(),
+        source,
+    };
+    let format = Format::from_path(path).map_err(read_err)?;
+    let bytes = std::fs::read(path).map_err(|source| IoError::File {
+        path: path.to_path_buf(),
+        action: "read",
+        source,
+    })?;
+    read_bytes(&bytes, format).map_err(read_err)
+}
+
+/// Writes `mesh` in `format` to `out` (uncompressed). See the [module docs](self) for
+/// the exact encodings. A triangle index out of range is an `InvalidInput` error;
+/// nothing else about the mesh is checked.
+pub fn write_to<W: Write>(out: W, mesh: &IndexedMesh, format: Format) -> std::io::Result<()> {
+    let n = mesh.positions.len();
+    if let Some((face, &index)) = mesh
+        .triangles
+        .iter()
+        .enumerate()
+        .find_map(|(f, t)| t.iter().find(|&&i| i as usize >= n).map(|i| (f, i)))
+    {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!("face {face} refers to vertex {index}, but there are only {n} vertices"),
+        ));
+    }
+    let mut out = std::io::BufWriter::with_capacity(1 << 16, out);
+    match format {
+        Format::Obj => obj::write(&mut out, mesh)?,
+        Format::Ply => ply::write(&mut out, mesh)?,
+        Format::Stl => stl::write(&mut out, mesh)?,
+        Format::Off => off::write(&mut out, mesh)?,
+    }
+    out.flush()
+}
+
+/// Writes `mesh` to `path` atomically, in the format its name gives (gzipped when it
+/// ends in `.gz`).
+///
+/// The data goes to a new temporary file in the same directory, which is flushed to
+/// disk and then renamed over `path`; on any error the temporary file is removed, so
+/// `path` either keeps its old content or gets the complete new one.
+pub fn write_path(path: &Path, mesh: &IndexedMesh) -> Result<(), IoError> {
+    let format = Format::from_path(path).map_err(|source| IoError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let gz = path
+        .file_name()
+        .and_then(|n| n.to_str())
+        .is_some_and(|n| strip_gz(n).is_some());
+    let file_err = |action, source| IoError::File {
+        path: path.to_path_buf(),
+        action,
+        source,
+    };
+    let (tmp, file) = create_temp_beside(path).map_err(|e| file_err("create a file beside", e))?;
+    let result = (|| -> std::io::Result<()> {
+        let file = if gz {
+            let mut enc = flate2::write::GzEncoder::new(file, flate2::Compression::default());
+            write_to(&mut enc, mesh, format)?;
+            enc.finish()?
+        } else {
+            let mut file = file;
+            write_to(&mut file, mesh, format)?;
+            file
+        };
+        file.sync_all()
+    })();
+    let result = result
+        .map_err(|e| file_err("write", e))
+        .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| file_err("rename into", e)));
+    if result.is_err() {
+        // Best effort: the error being reported is the one that matters.
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+/// Creates a fresh file next to `path` named `.NAME.qem-tmp-PID-N`.
+fn create_temp_beside(path: &Path) -> std::io::Result<(PathBuf, std::fs::File)> {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    loop {
+        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+        let tmp = dir.join(format!(".{name}.qem-tmp-{}-{n}", std::process::id()));
+        match std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&tmp)
+        {
+            Ok(f) => return Ok((tmp, f)),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            Err(e) => return Err(e),
+        }
+    }
+}
+
+/// What `bytes` look like, for error messages when they are not the claimed format.
+pub(crate) fn sniff(bytes: &[u8]) -> Option<&'static str> {
+    const MAGIC: [(&[u8], &str); 7] = [
+        (b"\x89PNG", "a PNG image"),
+        (b"\xff\xd8\xff", "a JPEG image"),
+        (b"GIF8", "a GIF image"),
+        (b"%PDF", "a PDF document"),
+        (b"PK\x03\x04", "a ZIP archive"),
+        (b"\x1f\x8b", "gzip data"),
+        (b"glTF", "a binary glTF file"),
+    ];
+    if let Some((_, what)) = MAGIC.iter().find(|(m, _)| bytes.starts_with(m)) {
+        return Some(what);
+    }
+    if bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n") {
+        return Some("a PLY file");
+    }
+    let head = &bytes[..bytes.len().min(4096)];
+    let first = text::first_content_line(head, b'#');
+    let word = first.split(|b| b.is_ascii_whitespace()).next()?;
+    if word.len() >= 3 && word.ends_with(b"OFF") && word.iter().all(u8::is_ascii_alphanumeric) {
+        return Some("an OFF file");
+    }
+    let trimmed = text::trim_start(bytes);
+    if trimmed.len() >= 5 && trimmed[..5].eq_ignore_ascii_case(b"solid") {
+        return Some("an ASCII STL file");
+    }
+    if head.iter().all(|&b| b >= 0x20 || b.is_ascii_whitespace())
+        && [
+            &b"v"[..],
+            b"vt",
+            b"vn",
+            b"f",
+            b"o",
+            b"g",
+            b"mtllib",
+            b"usemtl",
+            b"s",
+        ]
+        .contains(&word)
+    {
+        return Some("an OBJ file");
+    }
+    if head.contains(&0) {
+        return Some("binary data");
+    }
+    None
+}

@@ -1,0 +1,239 @@
+//! STL reader and writer.
+//!
+//! Binary or ASCII is decided by size, not by the `solid` prefix (many binary files
+//! start with `solid` too): data of exactly `84 + 50·n` bytes, where `n` is the
+//! little-endian count at byte 80, is binary. Otherwise data that starts with `solid`
+//! is ASCII. Each facet gives three new vertices: STL has no shared vertices and the
+//! reader does not weld (that is the cleaning stage's job). ASCII facets with more than
+//! three vertices are fan-triangulated.
+
+use std::io::Write;
+
+use super::text::{parse_f64, show, Tokens};
+use super::{sniff, Format, Location, ReadError};
+use crate::{IndexedMesh, InputError, MAX_ELEMENTS};
+
+const HEADER: usize = 84;
+const RECORD: usize = 50;
+
+pub(crate) fn read(bytes: &[u8]) -> Result<IndexedMesh, ReadError> {
+    let count = bytes
+        .get(80..84)
+        .and_then(|b| b.try_into().ok())
+        .map(u32::from_le_bytes);
+    if let Some(n) = count {
+        if (n as u64) * (RECORD as u64) + HEADER as u64 == bytes.len() as u64 {
+            return read_binary(bytes, n as usize);
+        }
+    }
+    let looks_like = sniff(bytes);
+    let head = &bytes[..bytes.len().min(1024)];
+    let textual = !head.contains(&0);
+    if looks_like == Some("an ASCII STL file") && textual {
+        return read_ascii(bytes);
+    }
+    match (count, looks_like) {
+        (Some(n), None | Some("an ASCII STL file") | Some("binary data")) => {
+            // Not ASCII: a binary STL whose size disagrees with its count.
+            let expected = n as u64 * RECORD as u64 + HEADER as u64;
+            if n as u64 > MAX_ELEMENTS as u64 {
+                return Err(ReadError::too_large(
+                    Location::Byte(80),
+                    "binary STL header claims triangles:",
+                    n as u64,
+                ));
+            }
+            if (bytes.len() as u64) < expected {
+                let done = (bytes.len() - HEADER) / RECORD;
+                Err(ReadError::truncated(
+                    Location::Byte(bytes.len() as u64),
+                    format!("after {done} of {n} triangles (binary STL of {expected} bytes)"),
+                ))
+            } else {
+                Err(ReadError::not_this_format(
+                    Format::Stl,
+                    looks_like.filter(|&l| l != "binary data"),
+                    format!(
+                        "binary STL header claims {n} triangles ({expected} bytes) \
+                         but there are {} bytes",
+                        bytes.len()
+                    ),
+                ))
+            }
+        }
+        _ => Err(ReadError::not_this_format(
+            Format::Stl,
+            looks_like,
+            "neither ASCII (\"solid ...\") nor binary (84 + 50 bytes per triangle)",
+        )),
+    }
+}
+
+fn read_binary(bytes: &[u8], n: usize) -> Result<IndexedMesh, ReadError> {
+    if n > MAX_ELEMENTS {
+        return Err(ReadError::too_large(
+            Location::Byte(80),
+            "binary STL header claims triangles:",
+            n as u64,
+        ));
+    }
+    let body = bytes.get(HEADER..).unwrap_or_default();
+    let mut positions = Vec::with_capacity(3 * n);
+    let mut triangles = Vec::with_capacity(n);
+    for (t, rec) in body.chunks_exact(RECORD).enumerate() {
+        for k in 0..3 {
+            let mut p = [0.0f64; 3];
+            for (c, slot) in p.iter_mut().enumerate() {
+                let o = 12 + 12 * k + 4 * c;
+                let raw = rec
+                    .get(o..o + 4)
+                    .and_then(|b| b.try_into().ok())
+                    .map(f32::from_le_bytes)
+                    .unwrap_or(f32::NAN);
+                *slot = f64::from(raw);
+            }
+            if !p.iter().all(|c| c.is_finite()) {
+                return Err(ReadError::mesh(
+                    Some(Location::Byte((HEADER + t * RECORD + 12 + 12 * k) as u64)),
+                    InputError::NonFiniteCoordinate {
+                        vertex: positions.len(),
+                    },
+                ));
+            }
+            positions.push(p);
+        }
+        let b = (3 * t) as u32;
+        triangles.push([b, b + 1, b + 2]);
+    }
+    Ok(IndexedMesh::new(positions, triangles))
+}
+
+fn read_ascii(bytes: &[u8]) -> Result<IndexedMesh, ReadError> {
+    let mut tok = Tokens::new(bytes, 1);
+    let mut positions: Vec<[f64; 3]> = Vec::new();
+    let mut triangles = Vec::new();
+    // Index in `positions` of the current facet's first vertex, while inside a facet.
+    let mut facet_start: Option<usize> = None;
+    let mut facets = 0usize;
+    while let Some(word) = tok.next_token() {
+        let line = tok.line();
+        let at = Location::Line(line);
+        let is = |kw: &[u8]| word.eq_ignore_ascii_case(kw);
+        if is(b"solid") || is(b"endsolid") {
+            // The rest of the line is a free-form name.
+            tok.skip_line();
+        } else if is(b"facet") {
+            if facet_start.is_some() {
+                return Err(ReadError::malformed(
+                    at,
+                    format!("facet {facets}: \"facet\" before \"endfacet\" of the previous one"),
+                ));
+            }
+            facet_start = Some(positions.len());
+        } else if is(b"vertex") {
+            let Some(start) = facet_start else {
+                return Err(ReadError::malformed(
+                    at,
+                    format!("\"vertex\" outside a facet (after facet {facets})"),
+                ));
+            };
+            let mut p = [0.0; 3];
+            for (k, c) in p.iter_mut().enumerate() {
+                let t = tok.next_token().unwrap_or_default();
+                *c = parse_f64(t).ok_or_else(|| {
+                    ReadError::malformed(
+                        Location::Line(tok.line()),
+                        format!(
+                            "facet {facets}, vertex {}: coordinate {k} is {}, not a number",
+                            positions.len() - start,
+                            show(t)
+                        ),
+                    )
+                })?;
+            }
+            if !p.iter().all(|c| c.is_finite()) {
+                return Err(ReadError::mesh(
+                    Some(at),
+                    InputError::NonFiniteCoordinate {
+                        vertex: positions.len(),
+                    },
+                ));
+            }
+            if positions.len() >= 3 * MAX_ELEMENTS {
+                return Err(ReadError::too_large(
+                    at,
+                    "STL vertices:",
+                    positions.len() as u64,
+                ));
+            }
+            positions.push(p);
+        } else if is(b"endfacet") {
+            let Some(start) = facet_start.take() else {
+                return Err(ReadError::malformed(at, "\"endfacet\" without \"facet\""));
+            };
+            let n = positions.len() - start;
+            if n < 3 {
+                return Err(ReadError::malformed(
+                    at,
+                    format!("facet {facets} has {n} vertices; a facet needs at least 3"),
+                ));
+            }
+            let a = start as u32;
+            for k in start + 1..positions.len() - 1 {
+                triangles.push([a, k as u32, k as u32 + 1]);
+            }
+            facets += 1;
+        }
+        // "normal", its three numbers, "outer", "loop" and "endloop" carry nothing we keep.
+    }
+    if facet_start.is_some() {
+        return Err(ReadError::truncated(
+            Location::Line(tok.line()),
+            format!("inside facet {facets}"),
+        ));
+    }
+    Ok(IndexedMesh::new(positions, triangles))
+}
+
+pub(crate) fn write(out: &mut impl Write, mesh: &IndexedMesh) -> std::io::Result<()> {
+    let mut header = [b' '; 80];
+    let tag = b"binary STL written by qem";
+    header[..tag.len()].copy_from_slice(tag);
+    out.write_all(&header)?;
+    let n = u32::try_from(mesh.triangles.len()).map_err(|_| {
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "more than 2^32 triangles do not fit in binary STL",
+        )
+    })?;
+    out.write_all(&n.to_le_bytes())?;
+    let mut rec = [0u8; RECORD];
+    for tri in &mesh.triangles {
+        // write_to checked the indices; a miss here would be a bug, written as origin.
+        let p = tri.map(|i| mesh.positions.get(i as usize).copied().unwrap_or_default());
+        let normal = facet_normal(p);
+        let values = normal.iter().chain(p.iter().flatten());
+        for (k, v) in values.enumerate() {
+            rec[4 * k..4 * k + 4].copy_from_slice(&(*v as f32).to_le_bytes());
+        }
+        out.write_all(&rec)?;
+    }
+    Ok(())
+}
+
+/// Unit normal of a triangle (counter-clockwise), or zero when it is degenerate.
+fn facet_normal([a, b, c]: [[f64; 3]; 3]) -> [f64; 3] {
+    let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+    let n = [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ];
+    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    if len > 0.0 && len.is_finite() {
+        n.map(|x| x / len)
+    } else {
+        [0.0; 3]
+    }
+}

@@ -1,0 +1,201 @@
+//! Byte-level helpers for the text formats: lines, tokens, numbers. No allocation.
+
+/// Lines of `data` with their 1-based numbers; `\r\n` and `\n` both end a line.
+pub(crate) fn lines(data: &[u8]) -> impl Iterator<Item = (usize, &[u8])> {
+    let mut rest = Some(data);
+    let mut no = 0usize;
+    std::iter::from_fn(move || {
+        let d = rest?;
+        no += 1;
+        let (line, next) = match d.iter().position(|&b| b == b'\n') {
+            Some(i) => (&d[..i], d.get(i + 1..)),
+            None => (d, None),
+        };
+        // A final newline does not start another (empty) line.
+        rest = next.filter(|r| !r.is_empty());
+        Some((no, line.strip_suffix(b"\r").unwrap_or(line)))
+    })
+}
+
+/// `s` without leading ASCII whitespace.
+pub(crate) fn trim_start(s: &[u8]) -> &[u8] {
+    let i = s
+        .iter()
+        .position(|b| !b.is_ascii_whitespace())
+        .unwrap_or(s.len());
+    &s[i..]
+}
+
+/// `s` without leading and trailing ASCII whitespace.
+pub(crate) fn trim(s: &[u8]) -> &[u8] {
+    let s = trim_start(s);
+    let j = s
+        .iter()
+        .rposition(|b| !b.is_ascii_whitespace())
+        .map_or(0, |j| j + 1);
+    &s[..j]
+}
+
+/// `line` cut at the first `comment` byte.
+pub(crate) fn strip_comment(line: &[u8], comment: u8) -> &[u8] {
+    match line.iter().position(|&b| b == comment) {
+        Some(i) => &line[..i],
+        None => line,
+    }
+}
+
+/// The first line that is not blank once its comment is removed (trimmed).
+pub(crate) fn first_content_line(data: &[u8], comment: u8) -> &[u8] {
+    lines(data)
+        .map(|(_, l)| trim(strip_comment(l, comment)))
+        .find(|l| !l.is_empty())
+        .unwrap_or(&[])
+}
+
+/// Whitespace-separated words of one line.
+pub(crate) fn words(line: &[u8]) -> impl Iterator<Item = &[u8]> {
+    line.split(|b| b.is_ascii_whitespace())
+        .filter(|w| !w.is_empty())
+}
+
+/// A cursor over whitespace-separated tokens that may span lines, counting lines.
+pub(crate) struct Tokens<'a> {
+    data: &'a [u8],
+    pos: usize,
+    line: usize,
+}
+
+impl<'a> Tokens<'a> {
+    /// Starts at `data[0]`, which is on line `first_line`.
+    pub(crate) fn new(data: &'a [u8], first_line: usize) -> Self {
+        Self {
+            data,
+            pos: 0,
+            line: first_line,
+        }
+    }
+
+    /// The line of the last token returned (or of the cursor when none was).
+    pub(crate) fn line(&self) -> usize {
+        self.line
+    }
+
+    /// Bytes not yet consumed.
+    pub(crate) fn remaining(&self) -> usize {
+        self.data.len().saturating_sub(self.pos)
+    }
+
+    /// The next token, or `None` at the end.
+    pub(crate) fn next_token(&mut self) -> Option<&'a [u8]> {
+        while let Some(&b) = self.data.get(self.pos) {
+            if !b.is_ascii_whitespace() {
+                break;
+            }
+            if b == b'\n' {
+                self.line += 1;
+            }
+            self.pos += 1;
+        }
+        let start = self.pos;
+        while let Some(&b) = self.data.get(self.pos) {
+            if b.is_ascii_whitespace() {
+                break;
+            }
+            self.pos += 1;
+        }
+        (self.pos > start).then(|| &self.data[start..self.pos])
+    }
+
+    /// Skips to the start of the next line.
+    pub(crate) fn skip_line(&mut self) {
+        match self
+            .data
+            .get(self.pos..)
+            .and_then(|r| r.iter().position(|&b| b == b'\n'))
+        {
+            Some(i) => self.pos += i,
+            None => self.pos = self.data.len(),
+        }
+    }
+}
+
+/// Parses a decimal floating-point number (Rust's syntax, which includes `inf` and
+/// `nan`; callers check finiteness).
+pub(crate) fn parse_f64(tok: &[u8]) -> Option<f64> {
+    std::str::from_utf8(tok).ok()?.parse().ok()
+}
+
+/// Parses a decimal integer with an optional sign (no allocation, overflow checked).
+pub(crate) fn parse_i64(tok: &[u8]) -> Option<i64> {
+    let (neg, digits) = match tok.split_first()? {
+        (b'-', rest) => (true, rest),
+        (b'+', rest) => (false, rest),
+        _ => (false, tok),
+    };
+    if digits.is_empty() {
+        return None;
+    }
+    let mut v: i64 = 0;
+    for &d in digits {
+        if !d.is_ascii_digit() {
+            return None;
+        }
+        let d = i64::from(d - b'0');
+        // Accumulate negatively so that i64::MIN parses too.
+        v = v.checked_mul(10)?.checked_sub(d)?;
+    }
+    if neg {
+        Some(v)
+    } else {
+        v.checked_neg()
+    }
+}
+
+/// A token as shown in an error message: lossy UTF-8, at most 40 characters.
+pub(crate) fn show(tok: &[u8]) -> String {
+    let s = String::from_utf8_lossy(tok);
+    if s.chars().count() > 40 {
+        let cut: String = s.chars().take(40).collect();
+        format!("\"{cut}...\"")
+    } else {
+        format!("\"{s}\"")
+    }
+}
+
+/// Caps a claimed element count by what `remaining` bytes of text could hold, for
+/// `Vec::with_capacity`: every element needs at least `min_bytes` bytes.
+pub(crate) fn capacity_for(claimed: usize, remaining: usize, min_bytes: usize) -> usize {
+    claimed.min(remaining / min_bytes.max(1))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lines_number_and_strip_cr() {
+        let v: Vec<_> = lines(b"a\r\nb\n\nc").collect();
+        assert_eq!(v, vec![(1, &b"a"[..]), (2, b"b"), (3, b""), (4, b"c")]);
+        assert_eq!(lines(b"a\n").count(), 1);
+    }
+
+    #[test]
+    fn parse_i64_edges() {
+        assert_eq!(parse_i64(b"-9223372036854775808"), Some(i64::MIN));
+        assert_eq!(parse_i64(b"9223372036854775808"), None);
+        assert_eq!(parse_i64(b"+12"), Some(12));
+        assert_eq!(parse_i64(b"-"), None);
+        assert_eq!(parse_i64(b"1x"), None);
+    }
+
+    #[test]
+    fn tokens_count_lines() {
+        let mut t = Tokens::new(b" a\n\n b c\n", 1);
+        assert_eq!(t.next_token(), Some(&b"a"[..]));
+        assert_eq!(t.line(), 1);
+        assert_eq!(t.next_token(), Some(&b"b"[..]));
+        assert_eq!(t.line(), 3);
+        assert_eq!(t.next_token(), Some(&b"c"[..]));
+        assert_eq!(t.next_token(), None);
+    }
+}
