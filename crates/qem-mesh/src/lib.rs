@@ -3,8 +3,6 @@
 //! - [`IndexedMesh`]: the plain input and output type, with validation.
 //! - `io` (feature `io`): readers and writers for OBJ, PLY, STL and OFF, with `.gz`.
 #![forbid(unsafe_code)]
-// Tests may unwrap: a panic there is the failure report.
-#![cfg_attr(test, allow(clippy::unwrap_used))]
 
 pub mod input;
 #[cfg(feature = "io")]
