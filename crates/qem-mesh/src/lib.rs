@@ -1,9 +1,15 @@
 //! Topology and the simplification algorithm of qem.
 //!
 //! - [`IndexedMesh`]: the plain input and output type, with validation.
+//! - [`MeshStore`]: the non-manifold adjacency store that contractions mutate.
 //! - `io` (feature `io`): readers and writers for OBJ, PLY, STL and OFF.
 #![forbid(unsafe_code)]
 
 pub mod input;
+pub mod store;
 
 pub use input::{IndexedMesh, InputError, MAX_ELEMENTS};
+pub use store::{
+    BuildStats, ContractError, ContractOutcome, EdgeClass, EdgeKey, FaceKey, MeshStore, StoreError,
+    VertexClass, VertexKey,
+};
