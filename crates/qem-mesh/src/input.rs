@@ -181,7 +181,9 @@ mod tests {
 
     #[test]
     fn empty_mesh_has_no_triangles() {
-        let err = IndexedMesh::default().validate().expect_err("the mesh is invalid");
+        let err = IndexedMesh::default()
+            .validate()
+            .expect_err("the mesh is invalid");
         assert_eq!(err, InputError::NoTriangles);
         assert_eq!(err.to_string(), "the mesh has no triangles");
     }
