@@ -193,6 +193,40 @@ impl Model {
         used.len()
     }
 
+    /// Lk a ∩ Lk b = Lk ab, over explicit sets.
+    fn link_condition(&self, a: u32, b: u32) -> bool {
+        let neighbours = |v: u32| -> BTreeSet<u32> {
+            self.edges
+                .iter()
+                .filter_map(|&(x, y)| (x == v).then_some(y).or((y == v).then_some(x)))
+                .collect()
+        };
+        let link_edges = |v: u32| -> BTreeSet<(u32, u32)> {
+            self.faces
+                .iter()
+                .filter(|f| f.contains(&v))
+                .map(|f| {
+                    let rest: Vec<u32> = f.iter().copied().filter(|&x| x != v).collect();
+                    pair(rest[0], rest[1])
+                })
+                .collect()
+        };
+        let lk_ab: BTreeSet<u32> = if self.edges.contains(&pair(a, b)) {
+            self.faces
+                .iter()
+                .filter(|f| f.contains(&a) && f.contains(&b))
+                .flat_map(|f| f.iter().copied().filter(|&x| x != a && x != b))
+                .collect()
+        } else {
+            BTreeSet::new()
+        };
+        let common: BTreeSet<u32> = neighbours(a)
+            .intersection(&neighbours(b))
+            .copied()
+            .collect();
+        common == lk_ab && link_edges(a).intersection(&link_edges(b)).next().is_none()
+    }
+
     fn sorted_faces(&self) -> Vec<[u32; 3]> {
         let mut out: Vec<_> = self.faces.iter().map(|&f| canonical(f)).collect();
         out.sort_unstable();
@@ -384,6 +418,20 @@ fn check(s: &Subject, m: &Model) {
                 }
                 (None, _) => assert_eq!(m.vertex_class(i), VertexClass::Isolated),
                 (_, None) => assert_eq!(m.vertex_class(j), VertexClass::Isolated),
+            }
+        }
+    }
+
+    // Link condition, for every ordered pair of live vertices.
+    for &i in &live {
+        for &j in &live {
+            if i != j {
+                let (vi, vj) = (s.keys[i as usize], s.keys[j as usize]);
+                assert_eq!(
+                    store.link_condition(vi, vj),
+                    m.link_condition(i, j),
+                    "link condition of {i} and {j}"
+                );
             }
         }
     }

@@ -452,3 +452,18 @@ fn same_operations_give_the_same_keys_and_output() {
     };
     assert_eq!(run(), run());
 }
+
+// Link condition. Tetrahedron edge 0-1: the link edge 2-3 is in both Lk 0 and Lk 1, so
+// contracting would pinch the sphere flat: refused. Strip edge 1-4 (see the strip sketch
+// above): common neighbours 0 and 5 are exactly its opposite vertices: allowed. Strip
+// pair 0 and 2 (no edge): common neighbour 1 but Lk 02 is empty: refused.
+#[test]
+fn link_condition_on_tetrahedron_and_strip() {
+    let (tet, keys) = build(4, &[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]);
+    assert!(!tet.link_condition(keys[0], keys[1]));
+    let (strip, keys) = build(6, &[[0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4]]);
+    assert!(strip.link_condition(keys[1], keys[4]));
+    assert!(strip.link_condition(keys[4], keys[1]));
+    assert!(!strip.link_condition(keys[0], keys[2]));
+    assert!(strip.link_condition(keys[3], keys[2]));
+}

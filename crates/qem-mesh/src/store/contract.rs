@@ -196,7 +196,7 @@ impl MeshStore {
     }
 
     /// The face on vertices `{a, x, y}` (any orientation), if any: a search of one fan.
-    fn find_face(&self, a: VertexKey, x: VertexKey, y: VertexKey) -> Option<FaceKey> {
+    pub(super) fn find_face(&self, a: VertexKey, x: VertexKey, y: VertexKey) -> Option<FaceKey> {
         let e = self.find_edge(a, x)?;
         self.edges[e]
             .fan

@@ -287,3 +287,158 @@ impl MeshStore {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    //! Each test breaks one invariant by hand and checks that `validate` names it: the
+    //! check must be able to fail for the model test's `validate()` calls to mean anything.
+
+    use super::*;
+    use crate::IndexedMesh;
+
+    /// Two triangles on the shared edge 1-2: `0 1 2` and `2 1 3`.
+    fn square() -> (MeshStore, Vec<VertexKey>) {
+        let mesh = IndexedMesh::new(vec![[0.0; 3]; 4], vec![[0, 1, 2], [2, 1, 3]]);
+        let (store, keys) = MeshStore::from_mesh(&mesh).expect("valid mesh");
+        assert_eq!(store.validate(), Ok(()));
+        (store, keys)
+    }
+
+    fn shared(store: &MeshStore, keys: &[VertexKey]) -> EdgeKey {
+        store.find_edge(keys[1], keys[2]).expect("edge 1-2")
+    }
+
+    #[test]
+    fn missing_and_repeated_star_entries() {
+        let (mut s, k) = square();
+        let e = shared(&s, &k);
+        s.vertices[k[1]].star.retain(|x| *x != e);
+        assert_eq!(
+            s.validate(),
+            Err(StoreError::EdgeNotInStarOnce {
+                edge: e,
+                vertex: k[1],
+                count: 0
+            })
+        );
+        let (mut s, k) = square();
+        s.vertices[k[2]].star.push(e);
+        assert!(matches!(
+            s.validate(),
+            Err(StoreError::EdgeNotInStarOnce { count: 2, .. })
+        ));
+        let (mut s, k) = square();
+        let far = s.find_edge(k[1], k[3]).expect("1-3");
+        s.vertices[k[0]].star.push(far);
+        assert!(matches!(
+            s.validate(),
+            Err(StoreError::StarEdgeNotIncident { .. })
+        ));
+    }
+
+    #[test]
+    fn broken_edges() {
+        let (mut s, k) = square();
+        let e = shared(&s, &k);
+        s.edges[e].vertices.swap(0, 1);
+        assert_eq!(s.validate(), Err(StoreError::EdgeNotCanonical { edge: e }));
+
+        let (mut s, k) = square();
+        let copy = s.edges.insert(super::super::Edge {
+            vertices: s.edges[e].vertices,
+            fan: Default::default(),
+        });
+        s.vertices[k[1]].star.push(copy);
+        s.vertices[k[2]].star.push(copy);
+        assert!(matches!(
+            s.validate(),
+            Err(StoreError::DuplicateEdge { .. })
+        ));
+
+        let (mut s, k) = square();
+        s.vertices.remove(k[3]);
+        assert!(matches!(
+            s.validate(),
+            Err(StoreError::EdgeVertexMissing { vertex, .. }) if vertex == k[3]
+        ));
+    }
+
+    #[test]
+    fn broken_fans() {
+        let (mut s, k) = square();
+        let e = shared(&s, &k);
+        let f = s.edges[e].fan[0];
+        s.edges[e].fan.push(f);
+        assert_eq!(
+            s.validate(),
+            Err(StoreError::FaceNotInFanOnce {
+                face: f,
+                edge: e,
+                count: 2
+            })
+        );
+        s.edges[e].fan.clear();
+        assert!(matches!(
+            s.validate(),
+            Err(StoreError::FaceNotInFanOnce { count: 0, .. })
+        ));
+
+        // Keys are deterministic, so `e` names the same edge in a fresh store.
+        let (mut s, _) = square();
+        let f = s.edges[e].fan[0];
+        s.faces.remove(f);
+        assert!(matches!(
+            s.validate(),
+            Err(StoreError::FanFaceMissing { face, .. }) if face == f
+        ));
+
+        let (mut s, k) = square();
+        let boundary = s.find_edge(k[0], k[1]).expect("0-1");
+        let other = s.edges[e].fan[1];
+        s.edges[boundary].fan.push(other);
+        assert_eq!(
+            s.validate(),
+            Err(StoreError::FanFaceNotIncident {
+                edge: boundary,
+                face: other
+            })
+        );
+    }
+
+    #[test]
+    fn broken_faces() {
+        let (mut s, k) = square();
+        let f = s.faces().next().expect("a face");
+        s.faces[f].vertices[2] = k[0];
+        assert_eq!(s.validate(), Err(StoreError::DegenerateFace { face: f }));
+
+        let (mut s, _) = square();
+        s.faces[f].edges.swap(0, 1);
+        assert_eq!(
+            s.validate(),
+            Err(StoreError::FaceEdgeMismatch { face: f, slot: 0 })
+        );
+
+        let (mut s, _) = square();
+        let mut copy = s.faces[f];
+        copy.vertices.reverse();
+        copy.edges = [copy.edges[1], copy.edges[0], copy.edges[2]];
+        let g = s.faces.insert(copy);
+        for e in copy.edges {
+            s.edges[e].fan.push(g);
+        }
+        assert_eq!(
+            s.validate(),
+            Err(StoreError::DuplicateFace {
+                first: f,
+                second: g
+            })
+        );
+        assert!(StoreError::DuplicateFace {
+            first: f,
+            second: g
+        }
+        .to_string()
+        .contains("same vertices"));
+    }
+}
