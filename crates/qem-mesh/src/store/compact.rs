@@ -54,6 +54,8 @@ impl MeshStore {
                 positions.push(vertex.position);
             }
         }
+        // Every face vertex was marked above, so the fallback is never taken; it only
+        // avoids a panic path.
         let triangles = self
             .faces
             .values()
