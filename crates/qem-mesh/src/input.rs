@@ -181,7 +181,9 @@ mod tests {
 
     #[test]
     fn empty_mesh_has_no_triangles() {
-        let err = IndexedMesh::default().validate().unwrap_err();
+        let err = IndexedMesh::default()
+            .validate()
+            .expect_err("the mesh is invalid");
         assert_eq!(err, InputError::NoTriangles);
         assert_eq!(err.to_string(), "the mesh has no triangles");
     }
@@ -190,7 +192,7 @@ mod tests {
     fn nan_coordinate_names_the_vertex() {
         let mut m = tri();
         m.positions[2][1] = f64::NAN;
-        let err = m.validate().unwrap_err();
+        let err = m.validate().expect_err("the mesh is invalid");
         assert_eq!(err, InputError::NonFiniteCoordinate { vertex: 2 });
         assert_eq!(err.to_string(), "vertex 2 has a non-finite coordinate");
     }
@@ -199,7 +201,7 @@ mod tests {
     fn out_of_range_index_names_the_face() {
         let mut m = tri();
         m.triangles.push([0, 1, 7]);
-        let err = m.validate().unwrap_err();
+        let err = m.validate().expect_err("the mesh is invalid");
         assert_eq!(
             err.to_string(),
             "face 1 refers to vertex 7, but there are only 3 vertices"
