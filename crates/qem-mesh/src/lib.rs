@@ -1,13 +1,20 @@
 //! Topology and the simplification algorithm of qem.
 //!
 //! - [`IndexedMesh`]: the plain input and output type, with validation.
+//! - [`clean`]: weld, drop degenerate and duplicate faces, with counts.
 //! - [`MeshStore`]: the non-manifold adjacency store that contractions mutate.
+//! - [`pairs`]: virtual pairs (close vertices that share no edge) from a uniform grid.
+//! - [`simplify`]: the Garland–Heckbert contraction loop, its options and report.
 //! - `io` (feature `io`): readers and writers for OBJ, PLY, STL and OFF, with `.gz`.
 #![forbid(unsafe_code)]
 
+pub mod clean;
 pub mod input;
 #[cfg(feature = "io")]
 pub mod io;
+pub mod pairs;
+mod queue;
+pub mod simplify;
 pub mod store;
 
 pub use input::{IndexedMesh, InputError, MAX_ELEMENTS};

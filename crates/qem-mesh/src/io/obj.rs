@@ -176,7 +176,7 @@ fn prescan(bytes: &[u8], detailed: bool) -> Result<Vec<std::ops::Range<usize>>, 
                 match (n_extra, first) {
                     (0 | 3, _) => {}
                     (_, Some(w)) if n_extra == 1 => {
-                        if parse_f64(w).map_or(true, |w| w == 0.0 || !w.is_finite()) {
+                        if parse_f64(w).is_none_or(|w| w == 0.0 || !w.is_finite()) {
                             return Err(ReadError::malformed(
                                 at,
                                 format!("vertex {v}: bad homogeneous weight {}", show(w)),

@@ -1,0 +1,129 @@
+//! Runs the built `qem` binary as a user would.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn qem(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_qem"))
+        .args(args)
+        .output()
+        .expect("qem runs")
+}
+
+fn spot() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/spot.obj")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn simplify_writes_mesh_and_report() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("spot-10.ply");
+    let report = dir.path().join("report.json");
+    let o = qem(&[
+        "simplify",
+        spot().to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--ratio",
+        "0.1",
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    for key in [
+        "input",
+        "output",
+        "triangles_in",
+        "triangles_out",
+        "vertices_in",
+        "vertices_out",
+        "edge_contractions",
+        "virtual_contractions",
+        "max_error",
+        "max_error_abs",
+        "stop_reason",
+        "cleanup",
+        "timings_ms",
+    ] {
+        assert!(json.get(key).is_some(), "report lacks {key}: {json}");
+    }
+    for key in ["load", "simplify", "write"] {
+        assert!(json["timings_ms"].get(key).is_some());
+    }
+    assert_eq!(json["triangles_in"], 5856);
+    assert!(json["triangles_out"].as_u64().unwrap() <= 585);
+    assert_eq!(json["stop_reason"], "target_reached");
+    let back = qem_mesh::io::read_path(&out).unwrap();
+    assert_eq!(
+        back.mesh.triangle_count() as u64,
+        json["triangles_out"].as_u64().unwrap()
+    );
+}
+
+#[test]
+fn missing_input_fails_with_one_line_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o.obj");
+    let o = qem(&["simplify", "no/such/file.obj", "-o", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    let e = stderr(&o);
+    assert_eq!(e.lines().count(), 1, "{e}");
+    assert!(e.starts_with("qem: error: no/such/file.obj: "), "{e}");
+    assert!(!out.exists());
+}
+
+#[test]
+fn corrupt_input_leaves_no_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.ply");
+    std::fs::write(
+        &bad,
+        b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n1\n",
+    )
+    .unwrap();
+    let out = dir.path().join("o.obj");
+    let o = qem(&[
+        "simplify",
+        bad.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("bad.ply"), "{}", stderr(&o));
+    assert!(!out.exists());
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        1,
+        "no stray files"
+    );
+}
+
+#[test]
+fn unknown_output_extension_fails_before_writing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o.xyz");
+    let o = qem(&[
+        "simplify",
+        spot().to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("o.xyz"), "{}", stderr(&o));
+    assert!(!out.exists());
+}
+
+#[test]
+fn usage_errors_exit_2() {
+    let o = qem(&["simplify", "a.obj", "-o", "b.obj", "--ratio", "1.5"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("outside (0, 1]"), "{}", stderr(&o));
+    let o = qem(&["simplify", "a.obj"]);
+    assert_eq!(o.status.code(), Some(2));
+}

@@ -1,0 +1,433 @@
+//! Cleaning passes run before simplification, each optional and each counted.
+//!
+//! Real meshes arrive as STL soups (every triangle with its own three vertices), with
+//! faces that repeat a vertex, faces of zero area, and the same face twice. The passes,
+//! in the order they run:
+//!
+//! 1. weld bit-identical positions (`-0.0` and `+0.0` count as the same coordinate);
+//! 2. weld within a tolerance (off by default);
+//! 3. drop faces with a repeated index (after welding, which can create them);
+//! 4. drop zero-area faces ([`ZERO_AREA_FRACTION`]);
+//! 5. drop duplicate faces: the same three vertices in any order. Back-to-back pairs
+//!    (the same triangle with opposite orientations) are duplicates by this rule: the
+//!    first occurrence is kept with its orientation, so a two-sided sheet becomes a
+//!    one-sided one;
+//! 6. drop unreferenced vertices.
+//!
+//! Everything is deterministic: vertices keep the order of their first occurrence and
+//! faces keep their order.
+
+use qem_core::{DVec3, Frame};
+use std::collections::HashMap;
+
+/// A face is zero-area when its area is at most this fraction of the squared
+/// bounding-box diagonal.
+///
+/// Why 1e-14: it is the threshold of the independent checker the project measures
+/// outputs with (`meshcheck.py`: "area ≤ 1e-14·diag²"), about 100 times the rounding
+/// of an area computed in f64 from coordinates of the diagonal's size, so a face below
+/// it has no direction we could trust for its normal.
+pub const ZERO_AREA_FRACTION: f64 = 1e-14;
+
+/// Which passes run. Start from [`CleanOptions::DEFAULT`] and adjust with `with_*`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct CleanOptions {
+    /// Merge vertices with bit-identical positions. Default: `true`.
+    pub weld_exact: bool,
+    /// Merge each vertex into the earliest kept vertex within this distance (model
+    /// units); `None` = off. Default: `None`.
+    pub weld_tolerance: Option<f64>,
+    /// Drop faces that use a vertex twice. Default: `true`.
+    pub drop_repeated_index: bool,
+    /// Drop faces whose area is at most [`ZERO_AREA_FRACTION`] of the squared
+    /// bounding-box diagonal. Default: `true`.
+    pub drop_zero_area: bool,
+    /// Drop faces with the same three vertices as an earlier face. Default: `true`.
+    pub drop_duplicates: bool,
+    /// Drop vertices no face uses. Default: `true`.
+    pub drop_unreferenced: bool,
+}
+
+impl CleanOptions {
+    /// Every pass on except the tolerance weld.
+    pub const DEFAULT: CleanOptions = CleanOptions {
+        weld_exact: true,
+        weld_tolerance: None,
+        drop_repeated_index: true,
+        drop_zero_area: true,
+        drop_duplicates: true,
+        drop_unreferenced: true,
+    };
+
+    /// The passes the simplifier runs on its own output: no welding (it would change
+    /// the topology the loop produced), every drop on, so the output is valid.
+    pub const OUTPUT: CleanOptions = CleanOptions {
+        weld_exact: false,
+        ..CleanOptions::DEFAULT
+    };
+
+    /// Sets [`weld_exact`](Self::weld_exact).
+    pub fn with_weld_exact(mut self, on: bool) -> Self {
+        self.weld_exact = on;
+        self
+    }
+
+    /// Sets [`weld_tolerance`](Self::weld_tolerance).
+    pub fn with_weld_tolerance(mut self, tolerance: Option<f64>) -> Self {
+        self.weld_tolerance = tolerance;
+        self
+    }
+
+    /// Sets [`drop_repeated_index`](Self::drop_repeated_index).
+    pub fn with_drop_repeated_index(mut self, on: bool) -> Self {
+        self.drop_repeated_index = on;
+        self
+    }
+
+    /// Sets [`drop_zero_area`](Self::drop_zero_area).
+    pub fn with_drop_zero_area(mut self, on: bool) -> Self {
+        self.drop_zero_area = on;
+        self
+    }
+
+    /// Sets [`drop_duplicates`](Self::drop_duplicates).
+    pub fn with_drop_duplicates(mut self, on: bool) -> Self {
+        self.drop_duplicates = on;
+        self
+    }
+
+    /// Sets [`drop_unreferenced`](Self::drop_unreferenced).
+    pub fn with_drop_unreferenced(mut self, on: bool) -> Self {
+        self.drop_unreferenced = on;
+        self
+    }
+}
+
+impl Default for CleanOptions {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
+}
+
+/// What the passes did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CleanReport {
+    /// Vertices merged into an earlier vertex with a bit-identical position.
+    pub welded_vertices: usize,
+    /// Vertices merged into an earlier vertex within the weld tolerance.
+    pub tolerance_welded_vertices: usize,
+    /// Faces dropped because they use a vertex twice.
+    pub repeated_index_faces: usize,
+    /// Faces dropped because their area is (numerically) zero.
+    pub zero_area_faces: usize,
+    /// Faces dropped as duplicates of an earlier face.
+    pub duplicate_faces: usize,
+    /// Vertices dropped because no face uses them (welded vertices not counted).
+    pub unreferenced_vertices: usize,
+}
+
+/// A cleaned mesh, what was done, and where each input vertex went.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Cleaned {
+    /// The cleaned mesh.
+    pub mesh: IndexedMesh,
+    /// The counts.
+    pub report: CleanReport,
+    /// For each input vertex, its index in `mesh`, or [`Cleaned::REMOVED`].
+    pub vertex_map: Vec<u32>,
+}
+
+impl Cleaned {
+    /// The `vertex_map` entry of a vertex that is not in the output.
+    pub const REMOVED: u32 = u32::MAX;
+}
+
+use crate::IndexedMesh;
+
+/// Runs the passes of `options` on `mesh`.
+///
+/// The mesh should have passed [`IndexedMesh::validate`]; out-of-range faces are
+/// dropped (and counted as repeated-index faces) rather than trusted.
+///
+/// ```
+/// use qem_mesh::clean::{clean, CleanOptions};
+/// use qem_mesh::IndexedMesh;
+/// // Two triangles of an STL soup sharing an edge: 6 vertices, 2 of them repeated.
+/// let soup = IndexedMesh::new(
+///     vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0],
+///          [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
+///     vec![[0, 1, 2], [3, 4, 5]],
+/// );
+/// let cleaned = clean(&soup, &CleanOptions::DEFAULT);
+/// assert_eq!(cleaned.mesh.vertex_count(), 4);
+/// assert_eq!(cleaned.mesh.triangles, vec![[0, 1, 2], [1, 3, 2]]);
+/// assert_eq!(cleaned.report.welded_vertices, 2);
+/// ```
+pub fn clean(mesh: &IndexedMesh, options: &CleanOptions) -> Cleaned {
+    let n = mesh.positions.len();
+    let mut report = CleanReport::default();
+    // representative[i]: the input vertex that i is merged into (itself if kept).
+    let mut representative: Vec<u32> = (0..n as u32).collect();
+    if options.weld_exact {
+        report.welded_vertices = weld_exact(&mesh.positions, &mut representative);
+    }
+    if let Some(tolerance) = options.weld_tolerance.filter(|t| *t > 0.0 && t.is_finite()) {
+        report.tolerance_welded_vertices =
+            weld_within(&mesh.positions, tolerance, &mut representative);
+    }
+
+    let frame = Frame::from_points(mesh.positions.iter().map(|p| DVec3::from_array(*p)));
+    let diagonal = frame.normalized_diagonal();
+    let min_double_area = 2.0 * ZERO_AREA_FRACTION * diagonal * diagonal;
+    let mut faces: Vec<[u32; 3]> = Vec::with_capacity(mesh.triangles.len());
+    for t in &mesh.triangles {
+        if t.iter().any(|&i| i as usize >= n) {
+            report.repeated_index_faces += 1;
+            continue;
+        }
+        let f = t.map(|i| representative[i as usize]);
+        if f[0] == f[1] || f[1] == f[2] || f[0] == f[2] {
+            if options.drop_repeated_index {
+                report.repeated_index_faces += 1;
+                continue;
+            }
+        } else if options.drop_zero_area {
+            let [a, b, c] =
+                f.map(|i| frame.to_normalized(DVec3::from_array(mesh.positions[i as usize])));
+            let double_area = (b - a).cross(c - a).length();
+            // `!(x > min)` also drops NaN areas, which only overflow could produce.
+            if double_area.is_nan() || double_area <= min_double_area {
+                report.zero_area_faces += 1;
+                continue;
+            }
+        }
+        faces.push(f);
+    }
+    if options.drop_duplicates {
+        report.duplicate_faces = drop_duplicate_faces(&mut faces);
+    }
+
+    // Number the surviving vertices in input order.
+    let mut referenced = vec![false; n];
+    for f in &faces {
+        for &i in f {
+            referenced[i as usize] = true;
+        }
+    }
+    let mut vertex_map = vec![Cleaned::REMOVED; n];
+    let mut positions = Vec::with_capacity(n);
+    for i in 0..n {
+        let is_representative = representative[i] as usize == i;
+        if !is_representative {
+            continue;
+        }
+        if referenced[i] || !options.drop_unreferenced {
+            vertex_map[i] = positions.len() as u32;
+            positions.push(mesh.positions[i]);
+        } else {
+            report.unreferenced_vertices += 1;
+        }
+    }
+    for i in 0..n {
+        vertex_map[i] = vertex_map[representative[i] as usize];
+    }
+    let triangles = faces
+        .iter()
+        .map(|f| f.map(|i| vertex_map[i as usize]))
+        .collect();
+    Cleaned {
+        mesh: IndexedMesh::new(positions, triangles),
+        report,
+        vertex_map,
+    }
+}
+
+/// The bit pattern of a coordinate, with `-0.0` read as `+0.0`.
+fn coordinate_bits(c: f64) -> u64 {
+    if c == 0.0 {
+        0
+    } else {
+        c.to_bits()
+    }
+}
+
+/// Points each vertex at the first vertex with a bit-identical position; returns how
+/// many were merged.
+fn weld_exact(positions: &[[f64; 3]], representative: &mut [u32]) -> usize {
+    let key = |i: u32| positions[i as usize].map(coordinate_bits);
+    let mut order: Vec<u32> = (0..positions.len() as u32).collect();
+    // Stable, so within a group the lowest index comes first.
+    order.sort_by_key(|&i| key(i));
+    let mut merged = 0;
+    let mut group_start = 0;
+    for k in 1..=order.len() {
+        if k == order.len() || key(order[k]) != key(order[group_start]) {
+            let first = order[group_start];
+            for &i in &order[group_start + 1..k] {
+                representative[i as usize] = first;
+                merged += 1;
+            }
+            group_start = k;
+        }
+    }
+    merged
+}
+
+/// Points each remaining representative at the earliest kept representative within
+/// `tolerance` (in index order), so the result does not depend on chains of near
+/// points; returns how many were merged.
+fn weld_within(positions: &[[f64; 3]], tolerance: f64, representative: &mut [u32]) -> usize {
+    let cell = |p: [f64; 3]| p.map(|c| (c / tolerance).floor() as i64);
+    let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+    let mut merged = 0;
+    let t2 = tolerance * tolerance;
+    for i in 0..positions.len() {
+        if representative[i] as usize != i {
+            // Already exact-welded: follow its representative's fate.
+            representative[i] = representative[representative[i] as usize];
+            continue;
+        }
+        let p = positions[i];
+        let c = cell(p);
+        let mut best: Option<u32> = None;
+        for dx in -1..=1i64 {
+            for dy in -1..=1i64 {
+                for dz in -1..=1i64 {
+                    let key = [
+                        c[0].saturating_add(dx),
+                        c[1].saturating_add(dy),
+                        c[2].saturating_add(dz),
+                    ];
+                    for &j in grid.get(&key).map(Vec::as_slice).unwrap_or(&[]) {
+                        let q = positions[j as usize];
+                        let d2 = (0..3).map(|k| (p[k] - q[k]) * (p[k] - q[k])).sum::<f64>();
+                        if d2 <= t2 && best.is_none_or(|b| j < b) {
+                            best = Some(j);
+                        }
+                    }
+                }
+            }
+        }
+        match best {
+            Some(j) => {
+                representative[i] = j;
+                merged += 1;
+            }
+            None => grid.entry(c).or_default().push(i as u32),
+        }
+    }
+    merged
+}
+
+/// Removes faces whose vertex set equals an earlier face's; returns how many.
+fn drop_duplicate_faces(faces: &mut Vec<[u32; 3]>) -> usize {
+    let sorted = |f: &[u32; 3]| {
+        let mut s = *f;
+        s.sort_unstable();
+        s
+    };
+    let mut order: Vec<u32> = (0..faces.len() as u32).collect();
+    order.sort_by_key(|&i| (sorted(&faces[i as usize]), i));
+    let mut keep = vec![true; faces.len()];
+    for w in order.windows(2) {
+        if sorted(&faces[w[0] as usize]) == sorted(&faces[w[1] as usize]) {
+            keep[w[1] as usize] = false;
+        }
+    }
+    let before = faces.len();
+    let mut k = 0;
+    faces.retain(|_| {
+        k += 1;
+        keep[k - 1]
+    });
+    before - faces.len()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn mesh(p: &[[f64; 3]], t: &[[u32; 3]]) -> IndexedMesh {
+        IndexedMesh::new(p.to_vec(), t.to_vec())
+    }
+
+    #[test]
+    fn signed_zeros_weld() {
+        let m = mesh(
+            &[
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [-0.0, 0.0, -0.0],
+            ],
+            &[[0, 1, 2], [3, 2, 1]],
+        );
+        let c = clean(&m, &CleanOptions::DEFAULT);
+        assert_eq!(c.report.welded_vertices, 1);
+        // [3,2,1] became [0,2,1]: the same vertex set as [0,1,2], a back-to-back pair.
+        assert_eq!(c.report.duplicate_faces, 1);
+        assert_eq!(c.mesh.triangles, vec![[0, 1, 2]]);
+        assert_eq!(c.vertex_map, vec![0, 1, 2, 0]);
+    }
+
+    #[test]
+    fn repeated_index_collinear_and_unreferenced() {
+        let m = mesh(
+            &[
+                [0.0; 3],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [2.0, 0.0, 0.0],
+                [5.0, 5.0, 5.0],
+            ],
+            &[[0, 1, 2], [0, 0, 1], [0, 1, 3]],
+        );
+        let c = clean(&m, &CleanOptions::DEFAULT);
+        assert_eq!(c.report.repeated_index_faces, 1);
+        assert_eq!(c.report.zero_area_faces, 1, "0,1,3 are collinear");
+        assert_eq!(
+            c.report.unreferenced_vertices, 2,
+            "3 (only in a dropped face) and 4"
+        );
+        assert_eq!(c.mesh.vertex_count(), 3);
+        assert_eq!(c.vertex_map[3], Cleaned::REMOVED);
+    }
+
+    #[test]
+    fn tolerance_weld_joins_near_but_not_far() {
+        let m = mesh(
+            &[
+                [0.0; 3],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [1.0005, 0.0, 0.0],
+                [1.0, 1.0, 0.0],
+                [0.0, 1.01, 0.0],
+            ],
+            &[[0, 1, 2], [3, 4, 5]],
+        );
+        let c = clean(&m, &CleanOptions::DEFAULT.with_weld_tolerance(Some(0.001)));
+        assert_eq!(c.report.tolerance_welded_vertices, 1);
+        assert_eq!(c.mesh.vertex_count(), 5);
+        assert_eq!(c.vertex_map[3], c.vertex_map[1]);
+        assert_ne!(c.vertex_map[5], c.vertex_map[2]);
+    }
+
+    #[test]
+    fn passes_can_be_turned_off() {
+        let m = mesh(
+            &[[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [9.0; 3]],
+            &[[0, 1, 2], [0, 1, 2], [0, 0, 1]],
+        );
+        let off = CleanOptions::DEFAULT
+            .with_drop_duplicates(false)
+            .with_drop_repeated_index(false)
+            .with_drop_unreferenced(false)
+            .with_drop_zero_area(false)
+            .with_weld_exact(false);
+        let c = clean(&m, &off);
+        assert_eq!(c.mesh, m);
+        assert_eq!(c.report, CleanReport::default());
+    }
+}

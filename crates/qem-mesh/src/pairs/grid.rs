@@ -1,0 +1,265 @@
+//! Virtual pairs from a uniform spatial grid of cell size t.
+//!
+//! Every point goes into the cell `floor(p / s)` with `s` slightly larger than `t`
+//! (so that rounding in the division can never put two points closer than `t` more
+//! than one cell apart). Pairs closer than `t` are then in the same or adjacent cells:
+//! each point looks at 27 cells. Cells live in a sorted vector, not a dense array (whose
+//! size would follow the bounding box, not the point count) nor a hash map (whose
+//! iteration order would make results depend on hashing).
+//!
+//! Cost: O(n log n) for the sort plus the number of points in neighbouring cells. For a
+//! mesh-like point set and a small t that is near linear. A t comparable to the whole
+//! model puts every point in a few cells and costs O(n²) distance tests; the per-vertex
+//! cap bounds the output (at most n·k pairs) but not those tests.
+
+/// Why 1e-9: the cell coordinate `p / s` is rounded to within a few ulps (relative
+/// 1e-16 each); enlarging the cell by 1e-9 keeps two points closer than `t` at most one
+/// cell apart with a margin of many orders of magnitude, while adding a negligible
+/// number of extra distance tests.
+const CELL_MARGIN: f64 = 1e-9;
+
+/// Options of the virtual-pair search.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct GridOptions {
+    /// Pairs at distance strictly less than this are found. Zero, negative or
+    /// non-finite means none. No default: it is the argument of [`GridOptions::new`].
+    pub threshold: f64,
+    /// Keep a pair only if it is among the `max_per_vertex` nearest candidates of at
+    /// least one of its two points (ties broken by the lower index). Default:
+    /// `usize::MAX` (no cap).
+    pub max_per_vertex: usize,
+}
+
+impl GridOptions {
+    /// Pairs closer than `threshold`, with no cap.
+    pub fn new(threshold: f64) -> Self {
+        Self {
+            threshold,
+            max_per_vertex: usize::MAX,
+        }
+    }
+
+    /// Sets [`max_per_vertex`](Self::max_per_vertex).
+    pub fn with_max_per_vertex(mut self, k: usize) -> Self {
+        self.max_per_vertex = k;
+        self
+    }
+}
+
+/// The pairs found.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct VirtualPairs {
+    /// Pairs `(i, j)` with `i < j`, sorted, without duplicates.
+    pub pairs: Vec<(u32, u32)>,
+    /// Allowed pairs closer than the threshold that the cap left out.
+    pub capped: usize,
+}
+
+/// Every pair of `points` closer than the threshold for which `allowed(i, j)` (called
+/// with `i < j`) is true, subject to the cap. Points must be finite.
+///
+/// ```
+/// use qem_mesh::pairs::{virtual_pairs, GridOptions};
+/// let points = [[0.0, 0.0, 0.0], [0.05, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.09, 0.0]];
+/// let found = virtual_pairs(&points, &GridOptions::new(0.1), |_, _| true);
+/// assert_eq!(found.pairs, vec![(0, 1), (0, 3)]);
+/// // (1, 3) is 0.103 apart: not closer than 0.1.
+/// ```
+pub fn virtual_pairs(
+    points: &[[f64; 3]],
+    options: &GridOptions,
+    mut allowed: impl FnMut(u32, u32) -> bool,
+) -> VirtualPairs {
+    let t = options.threshold;
+    if !(t > 0.0 && t.is_finite()) || options.max_per_vertex == 0 || points.len() < 2 {
+        return VirtualPairs::default();
+    }
+    let size = t * (1.0 + CELL_MARGIN);
+    // `as i64` saturates, so far-away points share the extreme cells: more tests, never
+    // a wrong answer, because every candidate is checked by its true distance.
+    let cell_of = |p: &[f64; 3]| p.map(|c| (c / size).floor() as i64);
+    let mut sorted: Vec<([i64; 3], u32)> = points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| (cell_of(p), i as u32))
+        .collect();
+    sorted.sort_unstable();
+
+    let t2 = t * t;
+    let k = options.max_per_vertex;
+    // Per point, its nearest allowed candidates (distance², other index), at most k.
+    let mut nearest: Vec<Vec<(f64, u32)>> = vec![Vec::new(); points.len()];
+    let mut total = 0usize;
+    for (cell, i) in &sorted {
+        let p = points[*i as usize];
+        for dx in -1..=1i64 {
+            for dy in -1..=1i64 {
+                for dz in -1..=1i64 {
+                    let key = [
+                        cell[0].saturating_add(dx),
+                        cell[1].saturating_add(dy),
+                        cell[2].saturating_add(dz),
+                    ];
+                    let start = sorted.partition_point(|(c, _)| *c < key);
+                    for (c, j) in &sorted[start..] {
+                        if *c != key {
+                            break;
+                        }
+                        // Each unordered pair once: from its lower index.
+                        if *j <= *i {
+                            continue;
+                        }
+                        let q = points[*j as usize];
+                        let d2 = (0..3).map(|a| (p[a] - q[a]) * (p[a] - q[a])).sum::<f64>();
+                        if d2 < t2 && allowed(*i, *j) {
+                            total += 1;
+                            offer(&mut nearest[*i as usize], (d2, *j), k);
+                            offer(&mut nearest[*j as usize], (d2, *i), k);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let mut pairs: Vec<(u32, u32)> = nearest
+        .iter()
+        .enumerate()
+        .flat_map(|(i, list)| {
+            let i = i as u32;
+            list.iter().map(move |&(_, j)| (i.min(j), i.max(j)))
+        })
+        .collect();
+    pairs.sort_unstable();
+    pairs.dedup();
+    let capped = total - pairs.len();
+    VirtualPairs { pairs, capped }
+}
+
+/// Inserts `candidate` into `list`, kept sorted by (distance², index) and at most `k`
+/// long.
+fn offer(list: &mut Vec<(f64, u32)>, candidate: (f64, u32), k: usize) {
+    let before = |a: &(f64, u32), b: &(f64, u32)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
+    let at = list.partition_point(|x| before(x, &candidate).is_lt());
+    if at < k {
+        list.insert(at, candidate);
+        list.truncate(k);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The documented rule, by brute force over all pairs.
+    fn brute_force(
+        points: &[[f64; 3]],
+        t: f64,
+        k: usize,
+        allowed: impl Fn(u32, u32) -> bool,
+    ) -> VirtualPairs {
+        let n = points.len() as u32;
+        let d2 = |i: u32, j: u32| {
+            let (p, q) = (points[i as usize], points[j as usize]);
+            (0..3).map(|a| (p[a] - q[a]) * (p[a] - q[a])).sum::<f64>()
+        };
+        let close = |i: u32, j: u32| i != j && d2(i, j) < t * t && allowed(i.min(j), i.max(j));
+        let nearest_of = |i: u32| {
+            let mut c: Vec<(f64, u32)> = (0..n)
+                .filter(|&j| close(i, j))
+                .map(|j| (d2(i, j), j))
+                .collect();
+            c.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            c.truncate(k);
+            c.into_iter().map(|(_, j)| j).collect::<Vec<_>>()
+        };
+        let lists: Vec<Vec<u32>> = (0..n).map(nearest_of).collect();
+        let mut pairs = Vec::new();
+        let mut total = 0;
+        for i in 0..n {
+            for j in i + 1..n {
+                if close(i, j) {
+                    total += 1;
+                    if lists[i as usize].contains(&j) || lists[j as usize].contains(&i) {
+                        pairs.push((i, j));
+                    }
+                }
+            }
+        }
+        VirtualPairs {
+            capped: total - pairs.len(),
+            pairs,
+        }
+    }
+
+    fn grid_points() -> impl Strategy<Value = Vec<[f64; 3]>> {
+        prop::collection::vec(prop::array::uniform3(0..5i32), 0..40)
+            .prop_map(|v| v.into_iter().map(|p| p.map(f64::from)).collect())
+    }
+
+    fn float_points() -> impl Strategy<Value = Vec<[f64; 3]>> {
+        prop::collection::vec(prop::array::uniform3(-2.0..2.0f64), 0..60)
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(256))]
+
+        #[test]
+        fn grid_equals_brute_force_on_integer_points(p in grid_points(), t in 0usize..6, k in 1usize..5) {
+            // Integer points and integer t: many pairs at exactly distance t (excluded).
+            let t = t as f64;
+            let all = |_: u32, _: u32| true;
+            prop_assert_eq!(virtual_pairs(&p, &GridOptions::new(t), all), brute_force(&p, t, usize::MAX, all));
+            prop_assert_eq!(
+                virtual_pairs(&p, &GridOptions::new(t).with_max_per_vertex(k), all),
+                brute_force(&p, t, k, all)
+            );
+        }
+
+        #[test]
+        fn grid_equals_brute_force_on_float_points(p in float_points(), t in 0.01..3.0f64, k in 1usize..4) {
+            let odd = |i: u32, j: u32| (i + j) % 3 != 0;
+            prop_assert_eq!(virtual_pairs(&p, &GridOptions::new(t), odd), brute_force(&p, t, usize::MAX, odd));
+            prop_assert_eq!(
+                virtual_pairs(&p, &GridOptions::new(t).with_max_per_vertex(k), odd),
+                brute_force(&p, t, k, odd)
+            );
+        }
+    }
+
+    #[test]
+    fn no_threshold_no_pairs() {
+        let p = [[0.0; 3], [0.0; 3]];
+        for t in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            assert_eq!(
+                virtual_pairs(&p, &GridOptions::new(t), |_, _| true),
+                VirtualPairs::default()
+            );
+        }
+    }
+
+    #[test]
+    fn coincident_points_all_pair_up_to_the_cap() {
+        let p = vec![[3.0; 3]; 6];
+        let all = virtual_pairs(&p, &GridOptions::new(1e-12), |_, _| true);
+        assert_eq!(all.pairs.len(), 15);
+        let capped = virtual_pairs(
+            &p,
+            &GridOptions::new(1e-12).with_max_per_vertex(1),
+            |_, _| true,
+        );
+        assert_eq!(capped, brute_force(&p, 1e-12, 1, |_, _| true));
+        assert_eq!(capped.pairs.len() + capped.capped, 15);
+    }
+
+    #[test]
+    fn extreme_scales_do_not_panic() {
+        let p = [[1e30, -1e30, 0.0], [1e30, -1e30, 1e-30], [-1e30, 1e30, 5.0]];
+        // Cell coordinates saturate at i64::MAX here; the true distances still decide.
+        let tiny = virtual_pairs(&p, &GridOptions::new(1e-29), |_, _| true);
+        assert_eq!(tiny.pairs, vec![(0, 1)]);
+        let huge = virtual_pairs(&p, &GridOptions::new(1e300), |_, _| true);
+        assert_eq!(huge.pairs, vec![(0, 1), (0, 2), (1, 2)]);
+    }
+}

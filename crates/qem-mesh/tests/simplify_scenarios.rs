@@ -1,0 +1,208 @@
+//! Named scenarios of the contraction engine with exact expectations.
+
+mod common;
+
+use common::{assert_valid, concat, grid, uv_sphere};
+use qem_mesh::simplify::{simplify, Length, SimplifyError, SimplifyOptions, StopReason, Target};
+use qem_mesh::store::{EdgeClass, MeshStore};
+use qem_mesh::IndexedMesh;
+
+fn options(target: Target) -> SimplifyOptions {
+    SimplifyOptions::DEFAULT.with_target(target)
+}
+
+fn edge_classes(mesh: &IndexedMesh) -> (usize, usize) {
+    let (store, _) = MeshStore::from_mesh(mesh).expect("valid output");
+    let mut boundary = 0;
+    let mut nonmanifold = 0;
+    for e in store.edges() {
+        match store.classify_edge(e) {
+            EdgeClass::Boundary => boundary += 1,
+            EdgeClass::NonManifold => nonmanifold += 1,
+            _ => {}
+        }
+    }
+    (boundary, nonmanifold)
+}
+
+fn components(mesh: &IndexedMesh) -> usize {
+    MeshStore::from_mesh(mesh)
+        .expect("valid output")
+        .0
+        .component_count()
+}
+
+#[test]
+fn closed_sphere_reaches_its_target_and_stays_closed() {
+    let sphere = uv_sphere([0.0; 3], 1.0, 16, 32);
+    let n = sphere.triangle_count();
+    let out = simplify(&sphere, &options(Target::Triangles(n / 10))).unwrap();
+    assert_valid(&out.mesh, n);
+    assert!(out.mesh.triangle_count() <= n / 10);
+    // Each edge contraction on a closed manifold removes two faces, so the loop lands
+    // at most one face under the target... or exactly on it.
+    assert!(out.mesh.triangle_count() + 2 >= n / 10);
+    assert_eq!(out.report.stop_reason, StopReason::TargetReached);
+    assert_eq!(out.report.virtual_contractions, 0);
+    assert_eq!(edge_classes(&out.mesh), (0, 0), "still closed and manifold");
+    assert!(out.report.max_error > 0.0 && out.report.max_error < 0.1);
+}
+
+#[test]
+fn open_strip_keeps_a_boundary() {
+    // A 20 x 2 strip of quads: every vertex is on the border.
+    let strip = grid(20, 2, 0.2);
+    let n = strip.triangle_count();
+    let out = simplify(&strip, &options(Target::Ratio(0.25))).unwrap();
+    assert_valid(&out.mesh, n);
+    let (boundary, _) = edge_classes(&out.mesh);
+    assert!(
+        boundary >= 3,
+        "the strip's border survives ({boundary} boundary edges)"
+    );
+    // Connectivity is not asserted: without boundary constraints a strip two quads
+    // wide may pinch into parts joined only by a wire edge, which is not output.
+}
+
+#[test]
+fn fin_edge_survives_contraction_of_its_neighbours() {
+    // Three 4x4 sheets ("wings") sharing one spine of 5 vertices: every spine edge has
+    // three faces (a fin).
+    //
+    //            wing 1
+    //              |
+    //   wing 3 ----+---- ... the spine runs out of the page, bent like a parabola
+    //               \
+    //              wing 2
+    //
+    // The spine is bent (x = 0.15 z²) so that sliding along it has a cost: a straight
+    // spine lies in every wing's planes and plain Garland–Heckbert would shrink it for
+    // free (boundary and feature constraints are the quality issue's business).
+    let wing = |angle: f64| {
+        let (s, c) = angle.sin_cos();
+        let mut positions = Vec::new();
+        for z in 0..=4 {
+            for u in 0..=4 {
+                let (u, z) = (u as f64, z as f64);
+                positions.push([0.15 * z * z + u * c, u * s, z]);
+            }
+        }
+        let g = grid(4, 4, 0.0);
+        IndexedMesh::new(positions, g.triangles)
+    };
+    let fin = concat(&[wing(1.0), wing(3.0), wing(5.0)]);
+    let n = fin.triangle_count();
+    let (_, nonmanifold_in) = edge_classes(&clean_only(&fin));
+    assert_eq!(nonmanifold_in, 4, "the spine: 4 edges with 3 faces each");
+    let out = simplify(&fin, &options(Target::Ratio(0.6))).unwrap();
+    assert_valid(&out.mesh, n);
+    let (_, nonmanifold) = edge_classes(&out.mesh);
+    assert!(nonmanifold >= 1, "the fin survives: {:?}", out.mesh);
+    assert!(out.report.edge_contractions > 0);
+    // Spine vertices of wings 2 and 3 weld onto wing 1's (when bit-identical).
+    assert_eq!(
+        out.report.cleanup.welded_vertices, 10,
+        "5 spine vertices x 2 extra wings"
+    );
+}
+
+fn clean_only(mesh: &IndexedMesh) -> IndexedMesh {
+    qem_mesh::clean::clean(mesh, &qem_mesh::clean::CleanOptions::DEFAULT).mesh
+}
+
+#[test]
+fn two_spheres_merge_only_with_virtual_pairs() {
+    // Radius 1, centres 2.04 apart: a gap of 0.04 = 2% of the size (diameter 2).
+    let pair = concat(&[
+        uv_sphere([0.0; 3], 1.0, 8, 16),
+        uv_sphere([2.04, 0.0, 0.0], 1.0, 8, 16),
+    ]);
+    let n = pair.triangle_count();
+    let edges_only = simplify(&pair, &options(Target::Ratio(0.3))).unwrap();
+    assert_valid(&edges_only.mesh, n);
+    assert_eq!(edges_only.report.virtual_contractions, 0);
+    assert_eq!(components(&edges_only.mesh), 2);
+
+    // The diagonal is about sqrt(4.04² + 2² + 2²) ≈ 4.93; t = 2% of it ≈ 0.1 > gap.
+    let merged = simplify(
+        &pair,
+        &options(Target::Ratio(0.3)).with_pair_threshold(Length::DiagonalFraction(0.02)),
+    )
+    .unwrap();
+    assert_valid(&merged.mesh, n);
+    assert!(merged.report.virtual_pairs > 0);
+    assert!(merged.report.virtual_contractions > 0);
+    assert_eq!(components(&merged.mesh), 1);
+}
+
+#[test]
+fn back_to_back_faces_are_cleaned_then_simplified() {
+    // A sphere plus, on top, a triangle and its reverse (same three vertices).
+    let mut mesh = uv_sphere([0.0; 3], 1.0, 8, 16);
+    let base = mesh.positions.len() as u32;
+    mesh.positions
+        .extend([[0.0, 0.0, 2.0], [1.0, 0.0, 2.0], [0.0, 1.0, 2.0]]);
+    mesh.triangles.push([base, base + 1, base + 2]);
+    mesh.triangles.push([base, base + 2, base + 1]);
+    let n = mesh.triangle_count();
+    let out = simplify(&mesh, &options(Target::Ratio(0.5))).unwrap();
+    assert_eq!(out.report.cleanup.duplicate_faces, 1);
+    assert_valid(&out.mesh, n);
+}
+
+#[test]
+fn all_degenerate_input_is_a_clear_error() {
+    let mesh = IndexedMesh::new(
+        vec![[0.0; 3], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]],
+        vec![[0, 1, 2], [0, 0, 1], [2, 1, 0]],
+    );
+    let err = simplify(&mesh, &options(Target::Ratio(0.5))).unwrap_err();
+    assert_eq!(
+        err,
+        SimplifyError::NothingLeftAfterCleaning { triangles_in: 3 }
+    );
+    assert!(err
+        .to_string()
+        .starts_with("all 3 triangles are degenerate"));
+}
+
+#[test]
+fn target_above_the_count_is_a_no_op() {
+    let sphere = uv_sphere([0.0; 3], 1.0, 6, 8);
+    let n = sphere.triangle_count();
+    let out = simplify(&sphere, &options(Target::Triangles(n + 10))).unwrap();
+    assert_eq!(
+        out.mesh, sphere,
+        "untouched vertices keep their exact coordinates"
+    );
+    assert_eq!(out.report.stop_reason, StopReason::TargetReached);
+    assert_eq!(
+        out.report.edge_contractions + out.report.virtual_contractions,
+        0
+    );
+    assert_eq!(out.report.max_error, 0.0);
+}
+
+#[test]
+fn max_error_stops_before_the_bound_is_exceeded() {
+    let sphere = uv_sphere([0.0; 3], 1.0, 16, 32);
+    let bound = 0.002;
+    let out = simplify(
+        &sphere,
+        &options(Target::Triangles(0)).with_max_error(Some(Length::DiagonalFraction(bound))),
+    )
+    .unwrap();
+    assert_eq!(out.report.stop_reason, StopReason::MaxErrorReached);
+    assert!(out.report.max_error <= bound);
+    assert!(out.mesh.triangle_count() < sphere.triangle_count());
+}
+
+#[test]
+fn same_input_same_output_bit_for_bit() {
+    let mesh = concat(&[uv_sphere([0.0; 3], 1.0, 10, 20), grid(6, 6, 0.5)]);
+    let o = options(Target::Ratio(0.2)).with_pair_threshold(Length::DiagonalFraction(0.05));
+    let a = simplify(&mesh, &o).unwrap();
+    let b = simplify(&mesh, &o).unwrap();
+    assert_eq!(a.mesh, b.mesh);
+    assert_eq!(a.report.max_error.to_bits(), b.report.max_error.to_bits());
+}
