@@ -12,7 +12,7 @@
 use crate::clean::{clean, CleanOptions, CleanReport};
 use crate::pairs::grid::{virtual_pairs, GridOptions};
 use crate::queue::{Candidate, PairQueue};
-use crate::store::{MeshStore, VertexKey};
+use crate::store::{MeshStore, StoreError, VertexKey};
 use crate::{IndexedMesh, InputError};
 use qem_core::{endpoint_placement, optimal_placement, DVec3, Frame, Placement, Quadric};
 use slotmap::SecondaryMap;
@@ -105,6 +105,10 @@ pub struct SimplifyOptions {
     pub weighting: Weighting,
     /// The cleaning passes run before simplification. Default: `CleanOptions::DEFAULT`.
     pub clean: CleanOptions,
+    /// Run the store's full invariant check ([`MeshStore::validate`]) after every
+    /// contraction and fail with [`SimplifyError::Internal`] if it breaks. For tests:
+    /// it costs O(n) per contraction. Default: `false`.
+    pub validate_each_contraction: bool,
 }
 
 impl SimplifyOptions {
@@ -117,6 +121,7 @@ impl SimplifyOptions {
         placement: PlacementMode::Optimal,
         weighting: Weighting::Area,
         clean: CleanOptions::DEFAULT,
+        validate_each_contraction: false,
     };
 
     /// Sets [`target`](Self::target).
@@ -152,6 +157,12 @@ impl SimplifyOptions {
     /// Sets [`weighting`](Self::weighting).
     pub fn with_weighting(mut self, weighting: Weighting) -> Self {
         self.weighting = weighting;
+        self
+    }
+
+    /// Sets [`validate_each_contraction`](Self::validate_each_contraction).
+    pub fn with_validate_each_contraction(mut self, on: bool) -> Self {
+        self.validate_each_contraction = on;
         self
     }
 
@@ -270,6 +281,9 @@ pub enum SimplifyError {
         /// How many triangles the input had.
         triangles_in: usize,
     },
+    /// A bug: the store broke an invariant (only detected with
+    /// [`SimplifyOptions::validate_each_contraction`]).
+    Internal(StoreError),
 }
 
 impl fmt::Display for SimplifyError {
@@ -281,6 +295,7 @@ impl fmt::Display for SimplifyError {
                 "all {triangles_in} triangles are degenerate (repeated vertex or zero area): \
                  nothing is left to simplify"
             ),
+            SimplifyError::Internal(e) => write!(f, "internal error, please report: {e}"),
         }
     }
 }
@@ -406,7 +421,7 @@ pub fn simplify_observed(
     timings.setup = clock.elapsed();
 
     let clock = Instant::now();
-    let stop_reason = engine.run(target_triangles, options, observer);
+    let stop_reason = engine.run(target_triangles, options, observer)?;
     timings.contract = clock.elapsed();
 
     let clock = Instant::now();
@@ -590,8 +605,7 @@ impl Engine {
         target: usize,
         options: &SimplifyOptions,
         observer: &mut dyn Observer,
-    ) -> StopReason {
-        let _ = options;
+    ) -> Result<StopReason, SimplifyError> {
         let start = self.store.face_count();
         let mut since_report = 0usize;
         let reason = loop {
@@ -612,6 +626,9 @@ impl Engine {
             }
             self.contract(a, b, placed, q);
             self.max_error = self.max_error.max(error);
+            if options.validate_each_contraction {
+                self.store.validate().map_err(SimplifyError::Internal)?;
+            }
 
             since_report += 1;
             if since_report == OBSERVER_INTERVAL {
@@ -631,7 +648,7 @@ impl Engine {
             triangles_start: start,
             target,
         });
-        reason
+        Ok(reason)
     }
 
     /// Contracts `b` into `a` at `placed`, merges their state, and queues the new pairs.
