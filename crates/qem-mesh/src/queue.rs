@@ -77,6 +77,17 @@ impl PairQueue {
         self.heap.push(candidate);
     }
 
+    /// Number of queued entries, stale ones included.
+    pub fn len(&self) -> usize {
+        self.heap.len()
+    }
+
+    /// Keeps only the entries for which `keep` is true (used to drop stale entries
+    /// when they outnumber the live ones, so the heap stays proportional to the mesh).
+    pub fn retain(&mut self, keep: impl FnMut(&Candidate) -> bool) {
+        self.heap.retain(keep);
+    }
+
     /// Removes and returns the cheapest candidate (stale or not).
     pub fn pop(&mut self) -> Option<Candidate> {
         self.heap.pop()

@@ -453,6 +453,19 @@ pub fn simplify_observed(
     Ok(Simplified { mesh: out, report })
 }
 
+/// When the queue holds more than this many entries per live pair, stale entries are
+/// dropped. Why 2: a rebuild costs O(queue) and happens after at least as many pushes,
+/// so it adds O(1) amortised per push while keeping the heap within 2x of minimal.
+const STALE_REBUILD_FACTOR: usize = 2;
+
+/// Whether a queued pair still describes the two vertices as they are now.
+fn is_current(state: &SecondaryMap<VertexKey, VertexState>, c: &Candidate) -> bool {
+    match (state.get(c.a), state.get(c.b)) {
+        (Some(sa), Some(sb)) => sa.stamp == c.stamp_a && sb.stamp == c.stamp_b,
+        _ => false,
+    }
+}
+
 /// What the loop keeps per vertex.
 #[derive(Clone, Debug, Default)]
 struct VertexState {
@@ -594,10 +607,7 @@ impl Engine {
     }
 
     fn is_current(&self, c: &Candidate) -> bool {
-        match (self.state.get(c.a), self.state.get(c.b)) {
-            (Some(sa), Some(sb)) => sa.stamp == c.stamp_a && sb.stamp == c.stamp_b,
-            _ => false,
-        }
+        is_current(&self.state, c)
     }
 
     fn run(
@@ -619,6 +629,14 @@ impl Engine {
                 continue;
             }
             let (a, b) = (candidate.a, candidate.b);
+            // Never contract the last faces away: the output must keep a triangle.
+            let shared_faces = self
+                .store
+                .find_edge(a, b)
+                .map_or(0, |e| self.store.fan(e).len());
+            if shared_faces >= self.store.face_count() {
+                continue;
+            }
             let (placed, q) = self.place(a, b);
             let error = q.rms_distance(placed.cost);
             if error > self.max_error_bound {
@@ -628,6 +646,16 @@ impl Engine {
             self.max_error = self.max_error.max(error);
             if options.validate_each_contraction {
                 self.store.validate().map_err(SimplifyError::Internal)?;
+            }
+
+            // Each contraction queues a fresh entry per neighbour and leaves the old
+            // ones stale; once stale entries dominate, drop them in one O(n) pass so
+            // the heap (and every pop) stays proportional to the live pairs.
+            if self.queue.len()
+                > STALE_REBUILD_FACTOR * (self.store.edge_count() + self.virtual_pairs) + 1024
+            {
+                let state = &self.state;
+                self.queue.retain(|c| is_current(state, c));
             }
 
             since_report += 1;
