@@ -17,6 +17,7 @@
 //! Everything is deterministic: vertices keep the order of their first occurrence and
 //! faces keep their order.
 
+use crate::pairs::grid::{neighbour_cells, squared_distance};
 use qem_core::{DVec3, Frame};
 use std::collections::HashMap;
 
@@ -291,21 +292,10 @@ fn weld_within(positions: &[[f64; 3]], tolerance: f64, representative: &mut [u32
         let p = positions[i];
         let c = cell(p);
         let mut best: Option<u32> = None;
-        for dx in -1..=1i64 {
-            for dy in -1..=1i64 {
-                for dz in -1..=1i64 {
-                    let key = [
-                        c[0].saturating_add(dx),
-                        c[1].saturating_add(dy),
-                        c[2].saturating_add(dz),
-                    ];
-                    for &j in grid.get(&key).map(Vec::as_slice).unwrap_or(&[]) {
-                        let q = positions[j as usize];
-                        let d2 = (0..3).map(|k| (p[k] - q[k]) * (p[k] - q[k])).sum::<f64>();
-                        if d2 <= t2 && best.is_none_or(|b| j < b) {
-                            best = Some(j);
-                        }
-                    }
+        for key in neighbour_cells(c) {
+            for &j in grid.get(&key).map(Vec::as_slice).unwrap_or(&[]) {
+                if squared_distance(p, positions[j as usize]) <= t2 && best.is_none_or(|b| j < b) {
+                    best = Some(j);
                 }
             }
         }

@@ -206,3 +206,16 @@ fn same_input_same_output_bit_for_bit() {
     assert_eq!(a.mesh, b.mesh);
     assert_eq!(a.report.max_error.to_bits(), b.report.max_error.to_bits());
 }
+
+#[test]
+fn a_target_of_zero_still_leaves_a_valid_mesh() {
+    // A ratio that rounds down to 0 triangles: contraction stops before the last faces
+    // would vanish, so the output keeps at least one triangle.
+    let sphere = uv_sphere([0.0; 3], 1.0, 6, 8);
+    let n = sphere.triangle_count();
+    let out = simplify(&sphere, &options(Target::Ratio(0.01))).unwrap();
+    assert_eq!(out.report.target_triangles, 0);
+    assert!(out.mesh.triangle_count() >= 1);
+    assert_valid(&out.mesh, n);
+    assert_eq!(out.report.stop_reason, StopReason::NoValidPair);
+}

@@ -93,31 +93,21 @@ pub fn virtual_pairs(
     let mut total = 0usize;
     for (cell, i) in &sorted {
         let p = points[*i as usize];
-        for dx in -1..=1i64 {
-            for dy in -1..=1i64 {
-                for dz in -1..=1i64 {
-                    let key = [
-                        cell[0].saturating_add(dx),
-                        cell[1].saturating_add(dy),
-                        cell[2].saturating_add(dz),
-                    ];
-                    let start = sorted.partition_point(|(c, _)| *c < key);
-                    for (c, j) in &sorted[start..] {
-                        if *c != key {
-                            break;
-                        }
-                        // Each unordered pair once: from its lower index.
-                        if *j <= *i {
-                            continue;
-                        }
-                        let q = points[*j as usize];
-                        let d2 = (0..3).map(|a| (p[a] - q[a]) * (p[a] - q[a])).sum::<f64>();
-                        if d2 < t2 && allowed(*i, *j) {
-                            total += 1;
-                            offer(&mut nearest[*i as usize], (d2, *j), k);
-                            offer(&mut nearest[*j as usize], (d2, *i), k);
-                        }
-                    }
+        for key in neighbour_cells(*cell) {
+            let start = sorted.partition_point(|(c, _)| *c < key);
+            for (c, j) in &sorted[start..] {
+                if *c != key {
+                    break;
+                }
+                // Each unordered pair once: from its lower index.
+                if *j <= *i {
+                    continue;
+                }
+                let d2 = squared_distance(p, points[*j as usize]);
+                if d2 < t2 && allowed(*i, *j) {
+                    total += 1;
+                    offer(&mut nearest[*i as usize], (d2, *j), k);
+                    offer(&mut nearest[*j as usize], (d2, *i), k);
                 }
             }
         }
@@ -134,6 +124,26 @@ pub fn virtual_pairs(
     pairs.dedup();
     let capped = total - pairs.len();
     VirtualPairs { pairs, capped }
+}
+
+/// The 27 cells around `cell` (itself included), saturating at the edges of i64.
+pub(crate) fn neighbour_cells(cell: [i64; 3]) -> impl Iterator<Item = [i64; 3]> {
+    (-1..=1i64).flat_map(move |dx| {
+        (-1..=1i64).flat_map(move |dy| {
+            (-1..=1i64).map(move |dz| {
+                [
+                    cell[0].saturating_add(dx),
+                    cell[1].saturating_add(dy),
+                    cell[2].saturating_add(dz),
+                ]
+            })
+        })
+    })
+}
+
+/// Squared Euclidean distance.
+pub(crate) fn squared_distance(p: [f64; 3], q: [f64; 3]) -> f64 {
+    (0..3).map(|a| (p[a] - q[a]) * (p[a] - q[a])).sum()
 }
 
 /// Inserts `candidate` into `list`, kept sorted by (distance², index) and at most `k`
