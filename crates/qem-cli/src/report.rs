@@ -31,6 +31,7 @@ pub struct SimplifyJson {
     stop_reason: &'static str,
     cleanup: BTreeMap<&'static str, usize>,
     degenerate_faces_removed: usize,
+    rejected_degenerate: usize,
     timings_ms: BTreeMap<&'static str, f64>,
 }
 
@@ -86,6 +87,7 @@ impl SimplifyJson {
             stop_reason: r.stop_reason.as_str(),
             cleanup,
             degenerate_faces_removed: r.degenerate_faces_removed,
+            rejected_degenerate: r.rejected_degenerate,
             timings_ms,
         }
     }

@@ -30,6 +30,12 @@ use std::collections::HashMap;
 /// it has no direction we could trust for its normal.
 pub const ZERO_AREA_FRACTION: f64 = 1e-14;
 
+/// Twice the largest area that counts as zero (so it compares with a cross product's
+/// length directly), for a bounding-box diagonal in the same units.
+pub fn min_double_area(diagonal: f64) -> f64 {
+    2.0 * ZERO_AREA_FRACTION * diagonal * diagonal
+}
+
 /// Which passes run. Start from [`CleanOptions::DEFAULT`] and adjust with `with_*`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
@@ -179,8 +185,7 @@ pub fn clean(mesh: &IndexedMesh, options: &CleanOptions) -> Cleaned {
     }
 
     let frame = Frame::from_points(mesh.positions.iter().map(|p| DVec3::from_array(*p)));
-    let diagonal = frame.normalized_diagonal();
-    let min_double_area = 2.0 * ZERO_AREA_FRACTION * diagonal * diagonal;
+    let min_double_area = min_double_area(frame.normalized_diagonal());
     let mut faces: Vec<[u32; 3]> = Vec::with_capacity(mesh.triangles.len());
     for t in &mesh.triangles {
         if t.iter().any(|&i| i as usize >= n) {

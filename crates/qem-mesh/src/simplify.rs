@@ -9,10 +9,10 @@
 //! in `[-1, 1]`), while the store keeps world coordinates, so vertices that are never
 //! moved come out bit for bit as they went in.
 
-use crate::clean::{clean, CleanOptions, CleanReport};
+use crate::clean::{clean, min_double_area, CleanOptions, CleanReport};
 use crate::pairs::grid::{virtual_pairs, GridOptions};
 use crate::queue::{Candidate, PairQueue};
-use crate::store::{MeshStore, StoreError, VertexKey};
+use crate::store::{FaceKey, MeshStore, StoreError, VertexKey};
 use crate::{IndexedMesh, InputError};
 use qem_core::{endpoint_placement, optimal_placement, DVec3, Frame, Placement, Quadric};
 use slotmap::SecondaryMap;
@@ -265,6 +265,9 @@ pub struct SimplifyReport {
     /// Faces of the result dropped at compaction because contraction left them with
     /// zero area.
     pub degenerate_faces_removed: usize,
+    /// Contractions refused because they would have left a surviving face with zero
+    /// area.
+    pub rejected_degenerate: usize,
     /// Wall time per phase.
     pub timings: Timings,
 }
@@ -448,6 +451,7 @@ pub fn simplify_observed(
         cleanup,
         degenerate_faces_removed: final_clean.report.zero_area_faces
             + final_clean.report.repeated_index_faces,
+        rejected_degenerate: engine.rejected_degenerate,
         timings,
     };
     Ok(Simplified { mesh: out, report })
@@ -493,6 +497,12 @@ struct Engine {
     virtual_pairs_capped: usize,
     /// Reused buffer of the neighbours of a vertex.
     scratch: Vec<VertexKey>,
+    /// Reused buffer of the faces around a vertex.
+    face_scratch: Vec<FaceKey>,
+    /// Twice the area at or below which a face counts as zero-area (normalised units).
+    min_double_area: f64,
+    /// Contractions refused because they would leave a zero-area face.
+    rejected_degenerate: usize,
 }
 
 impl Engine {
@@ -513,6 +523,9 @@ impl Engine {
             virtual_pairs: 0,
             virtual_pairs_capped: 0,
             scratch: Vec::new(),
+            face_scratch: Vec::new(),
+            min_double_area: min_double_area(frame.normalized_diagonal()),
+            rejected_degenerate: 0,
         }
     }
 
@@ -642,7 +655,12 @@ impl Engine {
             if error > self.max_error_bound {
                 break StopReason::MaxErrorReached;
             }
-            self.contract(a, b, placed, q);
+            let world = self.world_position(&placed, a);
+            if self.would_degenerate(a, b, world) {
+                self.rejected_degenerate += 1;
+                continue;
+            }
+            self.contract(a, b, world, q);
             self.max_error = self.max_error.max(error);
             if options.validate_each_contraction {
                 self.store.validate().map_err(SimplifyError::Internal)?;
@@ -679,13 +697,54 @@ impl Engine {
         Ok(reason)
     }
 
-    /// Contracts `b` into `a` at `placed`, merges their state, and queues the new pairs.
-    fn contract(&mut self, a: VertexKey, b: VertexKey, placed: Placement, q: Quadric) {
-        let mut world = self.frame.to_world(placed.position);
-        if !world.is_finite() {
-            // Only possible when the mesh spans nearly all of f64: keep a's position.
-            world = DVec3::from_array(self.store.position(a));
+    /// The world position of a placement; a non-finite one (possible only when the
+    /// mesh spans nearly all of f64) falls back to `a`'s position.
+    fn world_position(&self, placed: &Placement, a: VertexKey) -> DVec3 {
+        let world = self.frame.to_world(placed.position);
+        if world.is_finite() {
+            world
+        } else {
+            DVec3::from_array(self.store.position(a))
         }
+    }
+
+    /// Whether moving `a` and `b` to `world` would leave a surviving face of either
+    /// with (numerically) zero area — such a face would be dropped at output, and if
+    /// it were the last one the output would be empty.
+    fn would_degenerate(&mut self, a: VertexKey, b: VertexKey, world: DVec3) -> bool {
+        let moved = self.frame.to_normalized(world);
+        let mut faces = std::mem::take(&mut self.face_scratch);
+        let mut degenerate = false;
+        for v in [a, b] {
+            self.store.faces_of_vertex(v, &mut faces);
+            for &f in &faces {
+                let corners = self.store.face_vertices(f);
+                if corners.contains(&a) && corners.contains(&b) {
+                    continue; // collapses with the pair
+                }
+                let [p0, p1, p2] = corners.map(|c| {
+                    if c == a || c == b {
+                        moved
+                    } else {
+                        self.normalized_position(c)
+                    }
+                });
+                let double_area = (p1 - p0).cross(p2 - p0).length();
+                if double_area.is_nan() || double_area <= self.min_double_area {
+                    degenerate = true;
+                    break;
+                }
+            }
+            if degenerate {
+                break;
+            }
+        }
+        self.face_scratch = faces;
+        degenerate
+    }
+
+    /// Contracts `b` into `a` at `placed`, merges their state, and queues the new pairs.
+    fn contract(&mut self, a: VertexKey, b: VertexKey, world: DVec3, q: Quadric) {
         if self.store.find_edge(a, b).is_some() {
             self.edge_contractions += 1;
         } else {
