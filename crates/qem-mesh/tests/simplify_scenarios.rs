@@ -219,3 +219,30 @@ fn a_target_of_zero_still_leaves_a_valid_mesh() {
     assert_valid(&out.mesh, n);
     assert_eq!(out.report.stop_reason, StopReason::NoValidPair);
 }
+
+#[test]
+fn observer_sees_progress_and_can_cancel() {
+    use qem_mesh::simplify::{simplify_observed, Observer, Progress};
+    struct StopAtFirstReport(Vec<Progress>);
+    impl Observer for StopAtFirstReport {
+        fn progress(&mut self, p: Progress) {
+            self.0.push(p);
+        }
+        fn should_stop(&mut self) -> bool {
+            true
+        }
+    }
+    // 16,128 triangles: the observer is polled after 4,096 contractions.
+    let sphere = uv_sphere([0.0; 3], 1.0, 64, 128);
+    let n = sphere.triangle_count();
+    let mut observer = StopAtFirstReport(Vec::new());
+    let out = simplify_observed(&sphere, &options(Target::Ratio(0.01)), &mut observer).unwrap();
+    assert_eq!(out.report.stop_reason, StopReason::Cancelled);
+    assert_eq!(out.report.edge_contractions, 4096);
+    assert_valid(&out.mesh, n);
+    assert!(
+        observer.0.len() >= 2,
+        "a report when polled and one at the end"
+    );
+    assert!(observer.0[0].fraction() > 0.0 && observer.0[0].fraction() < 1.0);
+}
