@@ -395,6 +395,55 @@ pub fn simplify_observed(
     options: &SimplifyOptions,
     observer: &mut dyn Observer,
 ) -> Result<Simplified, SimplifyError> {
+    let mut levels = simplify_levels(mesh, options, &[options.target], observer)?;
+    // One target in, one level out (simplify_levels returns one result per target).
+    levels.pop().ok_or(SimplifyError::NothingLeftAfterCleaning {
+        triangles_in: mesh.triangle_count(),
+    })
+}
+
+/// A chain of levels of detail from one run: the loop contracts down to `levels[0]`,
+/// takes a copy of the mesh, then *continues* from there to `levels[1]`, and so on, so
+/// each level is a simplification of the previous one and the whole chain costs about
+/// as much as the coarsest level alone. `options.target` is ignored; every other option
+/// applies to every level.
+///
+/// Returns one [`Simplified`] per entry of `levels`, in order. Each level's report
+/// describes the run up to that level: contraction counts and `max_error` are
+/// cumulative, `timings.contract` is the loop time so far and `timings.compact` that
+/// level's copy. Levels whose target is above the count already reached repeat the
+/// previous mesh (with [`StopReason::TargetReached`]); once the loop stops short
+/// (error bound, no pair, cancelled), the later levels repeat the last mesh with the
+/// same stop reason.
+///
+/// ```
+/// use qem_mesh::simplify::{simplify_levels, NoObserver, SimplifyOptions, Target};
+/// use qem_mesh::IndexedMesh;
+/// // A 4x4 grid of squares, 32 triangles.
+/// let n = 5;
+/// let positions = (0..n * n).map(|i| [(i % n) as f64, (i / n) as f64, ((i * 7) % 3) as f64]).collect();
+/// let mut triangles = Vec::new();
+/// for y in 0..n - 1 {
+///     for x in 0..n - 1 {
+///         let v = (y * n + x) as u32;
+///         triangles.push([v, v + 1, v + n as u32]);
+///         triangles.push([v + 1, v + n as u32 + 1, v + n as u32]);
+///     }
+/// }
+/// let mesh = IndexedMesh::new(positions, triangles);
+/// let levels = [Target::Ratio(0.5), Target::Ratio(0.25)];
+/// let out = simplify_levels(&mesh, &SimplifyOptions::DEFAULT, &levels, &mut NoObserver)?;
+/// assert_eq!(out.len(), 2);
+/// assert!(out[0].mesh.triangle_count() <= 16);
+/// assert!(out[1].mesh.triangle_count() <= out[0].mesh.triangle_count());
+/// # Ok::<(), qem_mesh::simplify::SimplifyError>(())
+/// ```
+pub fn simplify_levels(
+    mesh: &IndexedMesh,
+    options: &SimplifyOptions,
+    levels: &[Target],
+    observer: &mut dyn Observer,
+) -> Result<Vec<Simplified>, SimplifyError> {
     let mut timings = Timings::default();
     let clock = Instant::now();
     mesh.validate()?;
@@ -412,49 +461,64 @@ pub fn simplify_observed(
     timings.build = clock.elapsed();
 
     let frame = Frame::from_points(cleaned.mesh.positions.iter().map(|p| DVec3::from_array(*p)));
-    let target_triangles = match options.target {
-        Target::Triangles(n) => n,
-        Target::Ratio(r) if r > 0.0 => (r.min(1.0) * mesh.triangle_count() as f64).floor() as usize,
-        Target::Ratio(_) => 0,
-        Target::None => 0,
-    };
     let mut engine = Engine::new(store, frame, options);
     let clock = Instant::now();
     engine.initialise(&cleaned.mesh, options);
     timings.setup = clock.elapsed();
 
-    let clock = Instant::now();
-    let stop_reason = engine.run(target_triangles, options, observer)?;
-    timings.contract = clock.elapsed();
+    let mut results = Vec::with_capacity(levels.len());
+    let mut stopped_short: Option<StopReason> = None;
+    for &level in levels {
+        let target_triangles = target_count(level, mesh.triangle_count());
+        let clock = Instant::now();
+        let stop_reason = match stopped_short {
+            Some(reason) => reason,
+            None => engine.run(target_triangles, options, observer)?,
+        };
+        if stop_reason != StopReason::TargetReached {
+            stopped_short = Some(stop_reason);
+        }
+        timings.contract += clock.elapsed();
 
-    let clock = Instant::now();
-    let raw = engine.store.to_mesh();
-    let final_clean = clean(&raw, &CleanOptions::OUTPUT);
-    let out = final_clean.mesh;
-    timings.compact = clock.elapsed();
+        let clock = Instant::now();
+        let raw = engine.store.to_mesh();
+        let final_clean = clean(&raw, &CleanOptions::OUTPUT);
+        let out = final_clean.mesh;
+        timings.compact = clock.elapsed();
 
-    let max_error = frame.distance_to_diagonal_fraction(engine.max_error);
-    let report = SimplifyReport {
-        triangles_in: mesh.triangle_count(),
-        vertices_in: mesh.vertex_count(),
-        triangles_out: out.triangle_count(),
-        vertices_out: out.vertex_count(),
-        target_triangles,
-        edge_contractions: engine.edge_contractions,
-        virtual_contractions: engine.virtual_contractions,
-        virtual_pairs: engine.virtual_pairs,
-        virtual_pairs_capped: engine.virtual_pairs_capped,
-        max_error,
-        max_error_abs: frame.distance_to_world(engine.max_error),
-        bbox_diagonal: frame.world_diagonal(),
-        stop_reason,
-        cleanup,
-        degenerate_faces_removed: final_clean.report.zero_area_faces
-            + final_clean.report.repeated_index_faces,
-        rejected_degenerate: engine.rejected_degenerate,
-        timings,
-    };
-    Ok(Simplified { mesh: out, report })
+        let report = SimplifyReport {
+            triangles_in: mesh.triangle_count(),
+            vertices_in: mesh.vertex_count(),
+            triangles_out: out.triangle_count(),
+            vertices_out: out.vertex_count(),
+            target_triangles,
+            edge_contractions: engine.edge_contractions,
+            virtual_contractions: engine.virtual_contractions,
+            virtual_pairs: engine.virtual_pairs,
+            virtual_pairs_capped: engine.virtual_pairs_capped,
+            max_error: frame.distance_to_diagonal_fraction(engine.max_error),
+            max_error_abs: frame.distance_to_world(engine.max_error),
+            bbox_diagonal: frame.world_diagonal(),
+            stop_reason,
+            cleanup,
+            degenerate_faces_removed: final_clean.report.zero_area_faces
+                + final_clean.report.repeated_index_faces,
+            rejected_degenerate: engine.rejected_degenerate,
+            timings,
+        };
+        results.push(Simplified { mesh: out, report });
+    }
+    Ok(results)
+}
+
+/// The triangle count a target asks for, given the input's count as loaded.
+fn target_count(target: Target, triangles_in: usize) -> usize {
+    match target {
+        Target::Triangles(n) => n,
+        Target::Ratio(r) if r > 0.0 => (r.min(1.0) * triangles_in as f64).floor() as usize,
+        Target::Ratio(_) => 0,
+        Target::None => 0,
+    }
 }
 
 /// When the queue holds more than this many entries per live pair, stale entries are

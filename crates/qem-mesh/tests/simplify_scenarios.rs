@@ -3,7 +3,10 @@
 mod common;
 
 use common::{assert_valid, concat, grid, uv_sphere};
-use qem_mesh::simplify::{simplify, Length, SimplifyError, SimplifyOptions, StopReason, Target};
+use qem_mesh::simplify::{
+    simplify, simplify_levels, Length, NoObserver, SimplifyError, SimplifyOptions, StopReason,
+    Target,
+};
 use qem_mesh::store::{EdgeClass, MeshStore};
 use qem_mesh::IndexedMesh;
 
@@ -245,4 +248,37 @@ fn observer_sees_progress_and_can_cancel() {
         "a report when polled and one at the end"
     );
     assert!(observer.0[0].fraction() > 0.0 && observer.0[0].fraction() < 1.0);
+}
+
+/// Levels of detail from one run: each level is nested in the previous one's count,
+/// and the first level is exactly what a plain run to that target gives (the chain
+/// continues the same contraction sequence rather than starting over).
+#[test]
+fn levels_continue_one_run_and_nest_in_count() {
+    let sphere = uv_sphere([0.0; 3], 1.0, 16, 32);
+    let n = sphere.triangle_count();
+    let levels = [
+        Target::Ratio(0.5),
+        Target::Ratio(0.25),
+        Target::Ratio(0.125),
+    ];
+    let out =
+        simplify_levels(&sphere, &SimplifyOptions::DEFAULT, &levels, &mut NoObserver).unwrap();
+    assert_eq!(out.len(), 3);
+    let mut previous = n;
+    for (level, target) in out.iter().zip([n / 2, n / 4, n / 8]) {
+        assert_valid(&level.mesh, n);
+        assert_eq!(level.report.stop_reason, StopReason::TargetReached);
+        assert!(level.mesh.triangle_count() <= target);
+        assert!(level.mesh.triangle_count() <= previous);
+        previous = level.mesh.triangle_count();
+    }
+    // Contraction counts are cumulative over the chain.
+    assert!(out[2].report.edge_contractions > out[0].report.edge_contractions);
+
+    // The error is monotone along the chain, and the first level is a plain run.
+    assert!(out[1].report.max_error >= out[0].report.max_error);
+    assert!(out[2].report.max_error >= out[1].report.max_error);
+    let single = simplify(&sphere, &options(levels[0])).unwrap();
+    assert_eq!(single.mesh, out[0].mesh);
 }
