@@ -12,6 +12,7 @@ pub mod clean;
 pub mod input;
 #[cfg(feature = "io")]
 pub mod io;
+pub mod measure;
 pub mod pairs;
 mod queue;
 pub mod simplify;
