@@ -4,6 +4,7 @@
 //! the cause), 2 on a usage error (from the argument parser).
 #![forbid(unsafe_code)]
 
+mod measure_cmd;
 mod report;
 mod simplify_cmd;
 
@@ -22,12 +23,15 @@ struct Cli {
 enum Command {
     /// Simplify one mesh file.
     Simplify(simplify_cmd::SimplifyArgs),
+    /// Metro-style distance between two meshes (Hausdorff, mean, RMS; % of A's diagonal).
+    Measure(measure_cmd::MeasureArgs),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Simplify(args) => simplify_cmd::run(&args),
+        Command::Measure(args) => measure_cmd::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
