@@ -98,7 +98,10 @@ pub fn run(args: &MeasureArgs) -> Result<(), String> {
         let text = serde_json::to_string_pretty(&json).map_err(|e| format!("JSON: {e}"))?;
         println!("{text}");
     } else {
-        print!("{}", human(args, &m, a.triangle_count(), b.triangle_count()));
+        print!(
+            "{}",
+            human(args, &m, a.triangle_count(), b.triangle_count())
+        );
     }
     Ok(())
 }

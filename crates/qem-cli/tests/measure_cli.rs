@@ -26,7 +26,12 @@ fn stdout(o: &Output) -> String {
 const FEW: [&str; 4] = ["--samples-per-face", "2", "--min-samples", "20000"];
 
 fn measure_json(a: &Path, b: &Path, extra: &[&str]) -> serde_json::Value {
-    let mut args = vec!["measure", a.to_str().unwrap(), b.to_str().unwrap(), "--json"];
+    let mut args = vec![
+        "measure",
+        a.to_str().unwrap(),
+        b.to_str().unwrap(),
+        "--json",
+    ];
     args.extend_from_slice(&FEW);
     args.extend_from_slice(extra);
     let o = qem(&args);

@@ -465,7 +465,11 @@ impl TriangleBvh {
         let scale = (0..3)
             .map(|k| root.lo[k].abs().max(root.hi[k].abs()))
             .fold(0.0, f64::max);
-        let slack = if scale.is_finite() { 1e-12 * scale } else { 0.0 };
+        let slack = if scale.is_finite() {
+            1e-12 * scale
+        } else {
+            0.0
+        };
         TriangleBvh {
             nodes,
             corners,
@@ -711,7 +715,11 @@ impl<'m> SampleSet<'m> {
         let r2 = rng.next_f64();
         let (u, v) = (1.0 - s1, s1 * (1.0 - r2));
         let w = 1.0 - u - v;
-        let (a, b, c) = (self.position(t[0]), self.position(t[1]), self.position(t[2]));
+        let (a, b, c) = (
+            self.position(t[0]),
+            self.position(t[1]),
+            self.position(t[2]),
+        );
         [
             u * a[0] + v * b[0] + w * c[0],
             u * a[1] + v * b[1] + w * c[1],
@@ -731,65 +739,71 @@ impl<'m> SampleSet<'m> {
     }
 }
 
-/// Which kind of sample a chunk holds, and where it starts.
+/// Which kind of sample a chunk holds.
 #[derive(Clone, Copy)]
-enum Chunk {
-    Vertices { start: u64, end: u64 },
-    Faces { index: u64, start: u64, end: u64 },
-    Boundary { index: u64, start: u64, end: u64 },
+enum Kind {
+    Vertices,
+    Faces,
+    Boundary,
 }
 
-fn chunks(kind: fn(u64, u64, u64) -> Chunk, total: u64) -> impl Iterator<Item = Chunk> {
-    (0..total.div_ceil(CHUNK)).map(move |i| kind(i, i * CHUNK, ((i + 1) * CHUNK).min(total)))
-}
+/// Chunks handed to rayon at a time: their partial sums are all that is kept in memory,
+/// however many samples were asked for.
+const CHUNKS_PER_ROUND: u64 = 256;
 
 /// Samples `from` and measures each sample's distance to the surface in `to`.
 fn directed(from: &IndexedMesh, to: &TriangleBvh, options: &MeasureOptions, seed: u64) -> Stats {
     let set = SampleSet::new(from, options);
-    let work: Vec<Chunk> = chunks(
-        |_, start, end| Chunk::Vertices { start, end },
-        set.vertices.len() as u64,
-    )
-    .chain(chunks(
-        |index, start, end| Chunk::Faces { index, start, end },
-        set.face_samples,
-    ))
-    .chain(chunks(
-        |index, start, end| Chunk::Boundary { index, start, end },
-        set.boundary_samples(),
-    ))
-    .collect();
-    let partial: Vec<Stats> = work
-        .par_iter()
-        .map(|chunk| {
-            let mut stats = Stats::default();
-            let mut add = |p: P3| {
-                if let Some(d) = to.distance(p) {
-                    stats.add(d);
-                }
-            };
-            match *chunk {
-                Chunk::Vertices { start, end } => {
-                    for k in start..end {
-                        add(set.position(set.vertices[k as usize]));
-                    }
-                }
-                Chunk::Faces { index, start, end } => {
-                    let mut rng = SplitMix64(stream_seed(seed, 2 * index));
-                    for _ in start..end {
-                        add(set.face_point(&mut rng));
-                    }
-                }
-                Chunk::Boundary { index, start, end } => {
-                    let mut rng = SplitMix64(stream_seed(seed, 2 * index + 1));
-                    for k in start..end {
-                        add(set.boundary_point(k, &mut rng));
-                    }
+    // Samples `start..end` of one kind, chunk number `index` of that kind.
+    let run_chunk = |kind: Kind, index: u64, start: u64, end: u64| {
+        let mut stats = Stats::default();
+        let mut add = |p: P3| {
+            if let Some(d) = to.distance(p) {
+                stats.add(d);
+            }
+        };
+        match kind {
+            Kind::Vertices => {
+                for k in start..end {
+                    add(set.position(set.vertices[k as usize]));
                 }
             }
-            stats
-        })
-        .collect();
-    // Combined in chunk order: the same sums whatever the thread count.
-    partial.into_iter().fold(Stats::default(), Stats::combine)
+            Kind::Faces => {
+                let mut rng = SplitMix64(stream_seed(seed, index.wrapping_mul(2)));
+                for _ in start..end {
+                    add(set.face_point(&mut rng));
+                }
+            }
+            Kind::Boundary => {
+                let mut rng = SplitMix64(stream_seed(seed, index.wrapping_mul(2) | 1));
+                for k in start..end {
+                    add(set.boundary_point(k, &mut rng));
+                }
+            }
+        }
+        stats
+    };
+    let mut total = Stats::default();
+    for (kind, count) in [
+        (Kind::Vertices, set.vertices.len() as u64),
+        (Kind::Faces, set.face_samples),
+        (Kind::Boundary, set.boundary_samples()),
+    ] {
+        let chunks = count.div_ceil(CHUNK);
+        let mut first = 0;
+        while first < chunks {
+            let last = first.saturating_add(CHUNKS_PER_ROUND).min(chunks);
+            let partial: Vec<Stats> = (first..last)
+                .into_par_iter()
+                .map(|i| {
+                    let start = i * CHUNK;
+                    run_chunk(kind, i, start, start.saturating_add(CHUNK).min(count))
+                })
+                .collect();
+            // Combined in chunk order: the same sums whatever the thread count.
+            total = partial.into_iter().fold(total, Stats::combine);
+            first = last;
+        }
+    }
+    total
 }

@@ -106,7 +106,11 @@ fn sample_counts_follow_the_options() {
     let spacing = (1.0f64 / 2000.0).sqrt();
     let boundary_min = (4.0 / spacing).ceil() as u64;
     assert!(m.samples_ab >= 36 + 2000 + boundary_min, "{}", m.samples_ab);
-    assert!(m.samples_ab <= 36 + 2000 + boundary_min + 20, "{}", m.samples_ab);
+    assert!(
+        m.samples_ab <= 36 + 2000 + boundary_min + 20,
+        "{}",
+        m.samples_ab
+    );
     let capped = MeasureOptions {
         max_samples: Some(100),
         ..small(0)
