@@ -28,15 +28,15 @@ const FEW: [&str; 4] = ["--samples-per-face", "2", "--min-samples", "20000"];
 fn measure_json(a: &Path, b: &Path, extra: &[&str]) -> serde_json::Value {
     let mut args = vec![
         "measure",
-        a.to_str().unwrap(),
-        b.to_str().unwrap(),
+        a.to_str().expect("UTF-8 path"),
+        b.to_str().expect("UTF-8 path"),
         "--json",
     ];
     args.extend_from_slice(&FEW);
     args.extend_from_slice(extra);
     let o = qem(&args);
     assert!(o.status.success(), "{}", stderr(&o));
-    serde_json::from_str(&stdout(&o)).unwrap()
+    serde_json::from_str(&stdout(&o)).expect("stdout is JSON")
 }
 
 #[test]

@@ -285,7 +285,7 @@ pub fn closest_point_on_triangle(p: [f64; 3], a: [f64; 3], b: [f64; 3], c: [f64;
         return along(b, sub(c, b), t); // edge region of bc
     }
     let denom = va + vb + vc;
-    if !(denom > 0.0) || !denom.is_finite() {
+    if denom.is_nan() || denom <= 0.0 || denom.is_infinite() {
         return closest_on_edges(p, a, b, c); // collinear corners
     }
     let v = vb / denom;
@@ -332,9 +332,9 @@ impl Aabb {
     };
 
     fn grow(&mut self, p: P3) {
-        for k in 0..3 {
-            self.lo[k] = self.lo[k].min(p[k]);
-            self.hi[k] = self.hi[k].max(p[k]);
+        for (k, &x) in p.iter().enumerate() {
+            self.lo[k] = self.lo[k].min(x);
+            self.hi[k] = self.hi[k].max(x);
         }
     }
 
@@ -342,8 +342,8 @@ impl Aabb {
     /// to anything inside the box, which is what makes the pruning exact.
     fn distance2(&self, p: P3) -> f64 {
         let mut s = 0.0;
-        for k in 0..3 {
-            let d = (self.lo[k] - p[k]).max(p[k] - self.hi[k]).max(0.0);
+        for (k, &x) in p.iter().enumerate() {
+            let d = (self.lo[k] - x).max(x - self.hi[k]).max(0.0);
             s += d * d;
         }
         s
