@@ -78,7 +78,5 @@ fn text(name: &str, i: &MeshInfo) -> String {
         ("bbox max", format!("{x1} {y1} {z1}")),
         ("bbox diagonal", i.bbox_diagonal.to_string()),
     ];
-    rows.iter()
-        .map(|(k, v)| format!("{k:<23}{v}\n"))
-        .collect()
+    rows.iter().map(|(k, v)| format!("{k:<23}{v}\n")).collect()
 }

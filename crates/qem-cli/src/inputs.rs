@@ -60,8 +60,7 @@ pub fn expand(args: &[PathBuf], out_dir: &Path) -> Expanded {
         } else {
             found.failures.push((
                 arg.display().to_string(),
-                "no such file or directory; check the path (globs need *, ? or [ ])"
-                    .to_string(),
+                "no such file or directory; check the path (globs need *, ? or [ ])".to_string(),
             ));
         }
     }
@@ -209,10 +208,7 @@ mod tests {
             Some(PathBuf::from("out/sub/a.obj"))
         );
         let i = input("x/b.stl", "b.stl");
-        assert_eq!(
-            output_path(&i, out, None),
-            Some(PathBuf::from("out/b.stl"))
-        );
+        assert_eq!(output_path(&i, out, None), Some(PathBuf::from("out/b.stl")));
         assert_eq!(output_path(&input("n.txt", "n.txt"), out, None), None);
         assert_eq!(
             output_path(&input("n.txt", "n.txt"), out, Some(Format::Obj)),

@@ -88,6 +88,8 @@ mod tests {
         assert!(parse_ratio("0").is_err());
         assert!(parse_ratio("1.01").is_err());
         assert!(parse_ratio("NaN").is_err());
-        assert!(parse_ratio("x").unwrap_err().contains("`x` is not a number"));
+        assert!(parse_ratio("x")
+            .unwrap_err()
+            .contains("`x` is not a number"));
     }
 }

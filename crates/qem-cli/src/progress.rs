@@ -88,7 +88,8 @@ impl Observer for BarObserver<'_> {
         if self.bar.is_hidden() {
             return;
         }
-        self.bar.set_position((p.fraction() * 1000.0).round() as u64);
+        self.bar
+            .set_position((p.fraction() * 1000.0).round() as u64);
         self.bar
             .set_message(format!("{} → {} triangles", p.triangles, p.target));
     }
