@@ -13,20 +13,20 @@ const CORRUPT_PLY: &[u8] =
 /// A folder with good meshes in four formats (one in a subfolder, one gzipped), a
 /// corrupt PLY, an unsupported file and a material file.
 fn messy_folder(root: &Path) {
-    std::fs::create_dir_all(root.join("sub")).unwrap();
-    std::fs::copy(spot(), root.join("spot.obj")).unwrap();
-    write_path(&root.join("grid.ply"), &bumpy_grid(12, 1)).unwrap();
-    write_path(&root.join("sub/grid.stl"), &bumpy_grid(10, 2)).unwrap();
-    write_path(&root.join("sub/more.off.gz"), &bumpy_grid(8, 3)).unwrap();
-    std::fs::write(root.join("corrupt.ply"), CORRUPT_PLY).unwrap();
-    std::fs::write(root.join("scene.gltf"), b"{\"asset\": {}}").unwrap();
-    std::fs::write(root.join("spot.mtl"), b"newmtl skin\n").unwrap();
+    std::fs::create_dir_all(root.join("sub")).expect("set up the test files");
+    std::fs::copy(spot(), root.join("spot.obj")).expect("set up the test files");
+    write_path(&root.join("grid.ply"), &bumpy_grid(12, 1)).expect("set up the test files");
+    write_path(&root.join("sub/grid.stl"), &bumpy_grid(10, 2)).expect("set up the test files");
+    write_path(&root.join("sub/more.off.gz"), &bumpy_grid(8, 3)).expect("set up the test files");
+    std::fs::write(root.join("corrupt.ply"), CORRUPT_PLY).expect("set up the test files");
+    std::fs::write(root.join("scene.gltf"), b"{\"asset\": {}}").expect("set up the test files");
+    std::fs::write(root.join("spot.mtl"), b"newmtl skin\n").expect("set up the test files");
 }
 
 fn files_under(dir: &Path) -> Vec<PathBuf> {
     let mut out: Vec<PathBuf> = walk(dir)
         .into_iter()
-        .map(|p| p.strip_prefix(dir).unwrap().to_path_buf())
+        .map(|p| p.strip_prefix(dir).expect("walk the output").to_path_buf())
         .collect();
     out.sort();
     out
@@ -34,8 +34,8 @@ fn files_under(dir: &Path) -> Vec<PathBuf> {
 
 fn walk(dir: &Path) -> Vec<PathBuf> {
     let mut out = Vec::new();
-    for e in std::fs::read_dir(dir).unwrap() {
-        let p = e.unwrap().path();
+    for e in std::fs::read_dir(dir).expect("walk the output") {
+        let p = e.expect("walk the output").path();
         if p.is_dir() {
             out.extend(walk(&p));
         } else {
