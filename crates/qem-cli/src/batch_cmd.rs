@@ -83,6 +83,16 @@ struct Task {
     refused: Option<String>,
 }
 
+impl Task {
+    /// Bytes on disk (compressed size for .gz), 0 when unknown: the scheduling key.
+    fn file_size(&self) -> u64 {
+        self.path
+            .as_ref()
+            .and_then(|p| std::fs::metadata(p).ok())
+            .map_or(0, |m| m.len())
+    }
+}
+
 /// Runs `qem batch`.
 pub fn run(args: &BatchArgs) -> Result<(), Failure> {
     let jobs = args.jobs.map_or_else(
@@ -111,20 +121,31 @@ pub fn run(args: &BatchArgs) -> Result<(), Failure> {
     let bar = batch_bar(bars_wanted(args.quiet), tasks.len());
     let failed_so_far = AtomicUsize::new(0);
     let clock = Instant::now();
-    let results: Vec<Result<SimplifyJson, String>> = pool.install(|| {
-        tasks
+    // Largest files first (longest-processing-time-first scheduling), so one big mesh
+    // does not start last and run alone; results go back to sorted order below, and
+    // each file's output does not depend on when it ran.
+    let mut order: Vec<usize> = (0..tasks.len()).collect();
+    let sizes: Vec<u64> = tasks.iter().map(Task::file_size).collect();
+    order.sort_by(|&a, &b| sizes[b].cmp(&sizes[a]).then(a.cmp(&b)));
+    let finished: Vec<(usize, Result<SimplifyJson, String>)> = pool.install(|| {
+        order
             .par_iter()
-            .map(|task| {
-                let result = run_task(task, &options);
+            .map(|&i| {
+                let result = run_task(&tasks[i], &options);
                 if result.is_err() {
                     let n = failed_so_far.fetch_add(1, Ordering::Relaxed) + 1;
                     bar.set_message(format!("{n} failed"));
                 }
                 bar.inc(1);
-                result
+                (i, result)
             })
             .collect()
     });
+    let mut results: Vec<Option<Result<SimplifyJson, String>>> =
+        (0..tasks.len()).map(|_| None).collect();
+    for (i, result) in finished {
+        results[i] = Some(result);
+    }
     let wall = clock.elapsed();
     bar.finish_and_clear();
 
@@ -133,6 +154,8 @@ pub fn run(args: &BatchArgs) -> Result<(), Failure> {
     let mut failures = Vec::new();
     let (mut triangles_in, mut triangles_out) = (0, 0);
     for (task, result) in tasks.iter().zip(results) {
+        let result =
+            result.unwrap_or_else(|| Err(format!("{}: was not run (a bug)", task.input)));
         match result {
             Ok(json) => {
                 triangles_in += json.triangles_in();
