@@ -154,8 +154,7 @@ pub fn run(args: &BatchArgs) -> Result<(), Failure> {
     let mut failures = Vec::new();
     let (mut triangles_in, mut triangles_out) = (0, 0);
     for (task, result) in tasks.iter().zip(results) {
-        let result =
-            result.unwrap_or_else(|| Err(format!("{}: was not run (a bug)", task.input)));
+        let result = result.unwrap_or_else(|| Err(format!("{}: was not run (a bug)", task.input)));
         match result {
             Ok(json) => {
                 triangles_in += json.triangles_in();
@@ -202,9 +201,14 @@ pub fn run(args: &BatchArgs) -> Result<(), Failure> {
             summary.input_triangles_per_second,
         );
         if !found.ignored.is_empty() {
+            let n = found.ignored.len();
             eprintln!(
-                "qem: ignored {} files that are not meshes (listed in the report)",
-                found.ignored.len()
+                "qem: ignored {n} {} not a mesh format (listed in the report)",
+                if n == 1 {
+                    "file that is"
+                } else {
+                    "files that are"
+                }
             );
         }
     }
