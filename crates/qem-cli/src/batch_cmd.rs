@@ -67,7 +67,8 @@ pub struct BatchArgs {
     #[arg(long, value_enum)]
     pub format: Option<FormatArg>,
     /// Write a JSON report here: one entry per input (the `qem simplify` report, or
-    /// `input`, `output` and `error`), the ignored files, and a summary.
+    /// `input`, `output` and `error`), the ignored files, and a summary [default: no
+    /// report].
     #[arg(long, value_name = "REPORT.json")]
     pub report: Option<PathBuf>,
     /// No progress bar and no summary line (failures are still printed).

@@ -38,8 +38,9 @@ pub struct SimplifyArgs {
         conflicts_with_all = ["ratio", "triangles"],
     )]
     pub lods: Vec<f64>,
-    /// Write a JSON report of the run here (with --lods: one entry per level).
-    #[arg(long)]
+    /// Write a JSON report of the run here (with --lods: one entry per level)
+    /// [default: no report].
+    #[arg(long, value_name = "REPORT.json")]
     pub report: Option<PathBuf>,
     /// No progress bar and no summary line (errors are still printed).
     #[arg(short, long)]
@@ -201,11 +202,19 @@ fn run_levels(args: &SimplifyArgs) -> Result<(), Failure> {
     Ok(())
 }
 
-/// Refuses an output name whose format qem cannot write, before any work is done.
+/// Refuses an output name whose format qem cannot write, or whose directory does not
+/// exist, before any work is done.
 fn check_output_name(output: &Path) -> Result<(), Failure> {
-    Format::from_path(output)
-        .map(|_| ())
-        .map_err(|e| Failure::Failed(format!("{}: {e}", output.display())))
+    Format::from_path(output).map_err(|e| Failure::Failed(format!("{}: {e}", output.display())))?;
+    match output.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() && !dir.is_dir() => Err(Failure::Failed(format!(
+            "{}: the directory {} does not exist; create it first (e.g. mkdir -p {})",
+            output.display(),
+            dir.display(),
+            dir.display()
+        ))),
+        _ => Ok(()),
+    }
 }
 
 fn lossy(p: &Path) -> String {
