@@ -311,16 +311,7 @@ fn run_task(task: &Task, options: &SimplifyOptions) -> Result<SimplifyJson, Stri
         (None, Err(e)) => return Err(format!("{}: {e}", task.input)),
         (None, Ok(_)) => return Err(format!("{}: no output name", task.input)),
     };
-    if let Some(parent) = output.parent() {
-        std::fs::create_dir_all(parent).map_err(|e| {
-            format!(
-                "{}: cannot create the directory {}: {e}",
-                task.input,
-                parent.display()
-            )
-        })?;
-    }
-    simplify_file(path, &output, options, &mut CtrlCObserver).map_err(|f| match f {
+    simplify_file(path, &output, options, &mut CtrlCObserver, true).map_err(|f| match f {
         Failure::Failed(m) | Failure::Usage(m) => m,
         Failure::Interrupted => format!(
             "{}: interrupted (Ctrl-C); nothing was written for it",

@@ -13,7 +13,7 @@
 //!   pattern's leading directories without wildcards (`meshes/**/*.ply` → relative to
 //!   `meshes`).
 //! - An argument that is none of these (a missing file, a pattern that matches
-//!   nothing) is a failed input of its own.
+//!   nothing), or a directory without a single mesh file, is a failed input of its own.
 
 use qem_mesh::io::Format;
 use std::path::{Component, Path, PathBuf};
@@ -45,7 +45,17 @@ pub fn expand(args: &[PathBuf], out_dir: &Path) -> Expanded {
     let mut found = Expanded::default();
     for arg in args {
         if arg.is_dir() {
+            let before = found.inputs.len();
             walk(arg, arg, out_canonical.as_deref(), &mut found);
+            if found.inputs.len() == before {
+                found.failures.push((
+                    arg.display().to_string(),
+                    format!(
+                        "no mesh file in this directory (looked for {})",
+                        qem_mesh::io::SUPPORTED_EXTENSIONS
+                    ),
+                ));
+            }
         } else if arg.exists() {
             let relative = arg
                 .file_name()

@@ -71,6 +71,7 @@ fn run_single(args: &SimplifyArgs) -> Result<(), Failure> {
         &args.output,
         &args.flags.options(),
         &mut BarObserver::new(&bar),
+        false,
     );
     bar.finish_and_clear();
     let json = result?;
@@ -84,12 +85,14 @@ fn run_single(args: &SimplifyArgs) -> Result<(), Failure> {
 }
 
 /// Loads `input`, simplifies it and writes `output` atomically; the report names both.
-/// Nothing is written when loading or simplifying fails or Ctrl-C stops the run.
+/// Nothing is written (and with `create_dirs`, no missing directory of `output` is
+/// created) when loading or simplifying fails or Ctrl-C stops the run.
 pub fn simplify_file(
     input: &Path,
     output: &Path,
     options: &SimplifyOptions,
     observer: &mut dyn Observer,
+    create_dirs: bool,
 ) -> Result<SimplifyJson, Failure> {
     let (mesh, load) = load(input)?;
     let clock = Instant::now();
@@ -98,6 +101,17 @@ pub fn simplify_file(
     let simplify_time = clock.elapsed();
     if result.report.stop_reason == StopReason::Cancelled || interrupted() {
         return Err(Failure::Interrupted);
+    }
+    if create_dirs {
+        if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(|e| {
+                Failure::Failed(format!(
+                    "{}: cannot create the directory {}: {e}",
+                    output.display(),
+                    dir.display()
+                ))
+            })?;
+        }
     }
     let write = write(output, &result)?;
     Ok(SimplifyJson::new(

@@ -412,3 +412,43 @@ fn ctrl_c_stops_cleanly() {
         "only finished files are written"
     );
 }
+
+#[test]
+fn failed_files_leave_no_directories_and_empty_folders_fail() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    std::fs::create_dir_all(input.join("deep/er")).unwrap();
+    std::fs::write(input.join("deep/er/corrupt.ply"), CORRUPT_PLY).unwrap();
+    write_path(&input.join("good.ply"), &bumpy_grid(4, 0)).unwrap();
+    let empty = dir.path().join("empty");
+    std::fs::create_dir_all(empty.join("only/notes")).unwrap();
+    std::fs::write(empty.join("only/notes/readme.txt"), b"no meshes here").unwrap();
+    let out = dir.path().join("out");
+    let report = dir.path().join("r.json");
+    let o = qem(&[
+        "batch",
+        s(&input),
+        s(&empty),
+        "--out-dir",
+        s(&out),
+        "--report",
+        s(&report),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert_eq!(files_under(&out), vec![PathBuf::from("good.ply")]);
+    assert!(!out.join("deep").exists(), "no directory for a failed file");
+    let r = json(&report);
+    let errors: Vec<&str> = r["inputs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|e| e["error"].as_str())
+        .collect();
+    assert_eq!(errors.len(), 2, "{errors:?}");
+    // Sorted by input: .../empty before .../in/deep/er/corrupt.ply.
+    assert!(
+        errors[0].contains("empty: no mesh file in this directory"),
+        "{errors:?}"
+    );
+    assert!(errors[1].contains("corrupt.ply: line 3"), "{errors:?}");
+}
