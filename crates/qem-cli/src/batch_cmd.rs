@@ -13,7 +13,6 @@ use crate::simplify_cmd::simplify_file;
 use clap::{Args, ValueEnum};
 use qem_mesh::io::Format;
 use qem_mesh::simplify::SimplifyOptions;
-use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -123,28 +122,30 @@ pub fn run(args: &BatchArgs) -> Result<(), Failure> {
     let failed_so_far = AtomicUsize::new(0);
     let clock = Instant::now();
     // Largest files first (longest-processing-time-first scheduling), so one big mesh
-    // does not start last and run alone; results go back to sorted order below, and
-    // each file's output does not depend on when it ran.
+    // does not start last and run alone. Every worker takes the next file of that list
+    // from a shared counter (a slice split in halves would start the second worker in
+    // the middle of the list instead). Results go back to sorted order below, and each
+    // file's output does not depend on when or where it ran.
     let mut order: Vec<usize> = (0..tasks.len()).collect();
     let sizes: Vec<u64> = tasks.iter().map(Task::file_size).collect();
     order.sort_by(|&a, &b| sizes[b].cmp(&sizes[a]).then(a.cmp(&b)));
-    let finished: Vec<(usize, Result<SimplifyJson, String>)> = pool.install(|| {
-        order
-            .par_iter()
-            .map(|&i| {
-                let result = run_task(&tasks[i], &options);
-                if result.is_err() {
-                    let n = failed_so_far.fetch_add(1, Ordering::Relaxed) + 1;
-                    bar.set_message(format!("{n} failed"));
-                }
-                bar.inc(1);
-                (i, result)
-            })
-            .collect()
+    let next = AtomicUsize::new(0);
+    let per_worker: Vec<Vec<(usize, Result<SimplifyJson, String>)>> = pool.broadcast(|_| {
+        let mut done = Vec::new();
+        while let Some(&i) = order.get(next.fetch_add(1, Ordering::Relaxed)) {
+            let result = run_task(&tasks[i], &options);
+            if result.is_err() {
+                let n = failed_so_far.fetch_add(1, Ordering::Relaxed) + 1;
+                bar.set_message(format!("{n} failed"));
+            }
+            bar.inc(1);
+            done.push((i, result));
+        }
+        done
     });
     let mut results: Vec<Option<Result<SimplifyJson, String>>> =
         (0..tasks.len()).map(|_| None).collect();
-    for (i, result) in finished {
+    for (i, result) in per_worker.into_iter().flatten() {
         results[i] = Some(result);
     }
     let wall = clock.elapsed();
