@@ -1,5 +1,6 @@
-//! JSON reports, written atomically.
+//! JSON reports, written atomically. Field names are the documented JSON keys.
 
+use qem_mesh::inspect::MeshInfo;
 use qem_mesh::simplify::SimplifyReport;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -7,8 +8,8 @@ use std::io::Write;
 use std::path::Path;
 use std::time::Duration;
 
-/// The report of one `qem simplify` run. Field names are the documented JSON keys.
-#[derive(Serialize, Debug)]
+/// The report of one `qem simplify` run (and of each file of `qem batch`).
+#[derive(Serialize, Debug, Clone)]
 pub struct SimplifyJson {
     input: String,
     output: String,
@@ -89,6 +90,148 @@ impl SimplifyJson {
             degenerate_faces_removed: r.degenerate_faces_removed,
             rejected_degenerate: r.rejected_degenerate,
             timings_ms,
+        }
+    }
+}
+
+impl SimplifyJson {
+    /// Triangles as loaded.
+    pub fn triangles_in(&self) -> usize {
+        self.triangles_in
+    }
+
+    /// Triangles written.
+    pub fn triangles_out(&self) -> usize {
+        self.triangles_out
+    }
+
+    /// One line for the terminal: `in → out: 5856 → 585 triangles, max error 0.4019%
+    /// of the bounding-box diagonal (target_reached)`.
+    pub fn summary_line(&self) -> String {
+        format!(
+            "{} → {}: {} → {} triangles, max error {:.4}% of the bounding-box diagonal ({})",
+            self.input,
+            self.output,
+            self.triangles_in,
+            self.triangles_out,
+            self.max_error * 100.0,
+            self.stop_reason
+        )
+    }
+}
+
+/// One level of `qem simplify --lods`.
+#[derive(Serialize, Debug)]
+pub struct LevelJson {
+    /// The level's index, what `{lod}` in the output name expands to.
+    pub lod: usize,
+    /// The level's target as a fraction of the input's triangles.
+    pub ratio: f64,
+    /// The run up to this level (counts and `max_error` are cumulative).
+    #[serde(flatten)]
+    pub run: SimplifyJson,
+}
+
+/// The report of `qem simplify --lods`: every level in order.
+#[derive(Serialize, Debug)]
+pub struct LevelsJson {
+    /// The input file.
+    pub input: String,
+    /// One entry per level.
+    pub levels: Vec<LevelJson>,
+}
+
+/// One input of `qem batch`: the `qem simplify` report, or why it failed.
+#[derive(Serialize, Debug)]
+#[serde(untagged)]
+pub enum BatchEntry {
+    /// The file was simplified and written.
+    Done(SimplifyJson),
+    /// The file failed; nothing was written for it.
+    Failed {
+        /// The input file.
+        input: String,
+        /// Where its output would have gone, when that was decided.
+        output: Option<String>,
+        /// The one-line cause.
+        error: String,
+    },
+}
+
+/// Totals of a `qem batch` run.
+#[derive(Serialize, Debug)]
+pub struct BatchSummary {
+    /// Inputs found (files named, matched by globs, found in directories).
+    pub inputs: usize,
+    /// Inputs simplified and written.
+    pub succeeded: usize,
+    /// Inputs that failed (or were not started because of Ctrl-C).
+    pub failed: usize,
+    /// Whether Ctrl-C stopped the run.
+    pub interrupted: bool,
+    /// Worker threads.
+    pub jobs: usize,
+    /// Triangles of the succeeded inputs, as loaded.
+    pub triangles_in: usize,
+    /// Triangles written.
+    pub triangles_out: usize,
+    /// Wall time of the whole run, from the first load to the last write.
+    pub wall_ms: f64,
+    /// `triangles_in` per second of `wall_ms`.
+    pub input_triangles_per_second: f64,
+}
+
+/// The report of `qem batch`.
+#[derive(Serialize, Debug)]
+pub struct BatchJson {
+    /// One entry per input, sorted by input path.
+    pub inputs: Vec<BatchEntry>,
+    /// Files in the given directories that were skipped because their extension is not
+    /// a mesh format qem reads (materials, textures, notes...), sorted.
+    pub ignored: Vec<String>,
+    /// Totals.
+    pub summary: BatchSummary,
+}
+
+/// The JSON of `qem info --json`.
+#[derive(Serialize, Debug)]
+pub struct InfoJson {
+    input: String,
+    vertices: usize,
+    triangles: usize,
+    welded_vertices: usize,
+    unreferenced_vertices: usize,
+    components: usize,
+    boundary_edges: usize,
+    boundary_loops: usize,
+    nonmanifold_edges: usize,
+    nonmanifold_vertices: usize,
+    duplicate_faces: usize,
+    degenerate_faces: usize,
+    bbox_min: [f64; 3],
+    bbox_max: [f64; 3],
+    bbox_diagonal: f64,
+}
+
+impl InfoJson {
+    /// The counts of `info` for the file `input`.
+    pub fn new(input: &Path, info: &MeshInfo) -> Self {
+        InfoJson {
+            input: input.display().to_string(),
+            vertices: info.vertices,
+            triangles: info.triangles,
+            welded_vertices: info.welded_vertices,
+            unreferenced_vertices: info.unreferenced_vertices,
+            components: info.components,
+            boundary_edges: info.boundary_edges,
+            boundary_loops: info.boundary_loops,
+            nonmanifold_edges: info.nonmanifold_edges,
+            nonmanifold_vertices: info.nonmanifold_vertices,
+            duplicate_faces: info.duplicate_faces,
+            degenerate_faces: info.degenerate_faces,
+            bbox_min: info.bbox_min,
+            bbox_max: info.bbox_max,
+            bbox_diagonal: info.bbox_diagonal,
         }
     }
 }

@@ -1,113 +1,242 @@
-//! `qem simplify`: one file in, one simplified file out, an optional JSON report.
+//! `qem simplify`: one file in, one simplified file (or a chain of levels of detail)
+//! out, an optional JSON report.
 
-use crate::report::{write_json_atomically, SimplifyJson};
+use crate::failure::Failure;
+use crate::options::{parse_ratio, SimplifyFlags};
+use crate::progress::{bars_wanted, interrupted, simplify_bar, BarObserver};
+use crate::report::{write_json_atomically, LevelJson, LevelsJson, SimplifyJson};
 use clap::Args;
-use qem_mesh::io::{read_path, write_path};
-use qem_mesh::simplify::{simplify, Length, SimplifyOptions, Target};
-use std::path::PathBuf;
-use std::time::Instant;
+use qem_mesh::io::{read_path, write_path, Format};
+use qem_mesh::simplify::{
+    simplify_levels, simplify_observed, Observer, Simplified, SimplifyOptions, StopReason, Target,
+};
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+/// The placeholder in `-o` that `--lods` replaces with the level's index.
+pub const LOD_PLACEHOLDER: &str = "{lod}";
 
 /// Arguments of `qem simplify`.
 #[derive(Args, Debug)]
 pub struct SimplifyArgs {
     /// Input mesh (.obj .ply .stl .off, optionally .gz).
     pub input: PathBuf,
-    /// Output mesh; the format follows the extension (.obj .ply .stl .off).
+    /// Output mesh; the format follows the extension (.obj .ply .stl .off, optionally
+    /// .gz). With --lods it must contain {lod}, which becomes the level's index
+    /// (0, 1, 2, ... in the order of --lods).
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Target as a fraction of the input's triangles, in (0, 1] [default: 0.5 when
-    /// --triangles is not given].
-    #[arg(long, conflicts_with = "triangles", value_parser = parse_ratio)]
-    pub ratio: Option<f64>,
-    /// Target triangle count.
-    #[arg(long)]
-    pub triangles: Option<usize>,
-    /// Stop before the first contraction whose error would exceed this distance: a
-    /// fraction of the input's bounding-box diagonal, or model units with --absolute
-    /// [default: no bound].
-    #[arg(long, value_parser = parse_non_negative)]
-    pub max_error: Option<f64>,
-    /// Unconnected vertex pairs closer than this may merge (virtual pairs): a fraction
-    /// of the bounding-box diagonal, or model units with --absolute; 0 = edges only.
-    #[arg(long, default_value_t = 0.0, value_parser = parse_non_negative)]
-    pub pair_threshold: f64,
-    /// Read --max-error and --pair-threshold in model units instead of fractions of the
-    /// bounding-box diagonal.
-    #[arg(long)]
-    pub absolute: bool,
-    /// Write a JSON report of the run here.
-    #[arg(long)]
+    #[command(flatten)]
+    pub flags: SimplifyFlags,
+    /// Levels of detail from one run, as fractions of the input's triangles, largest
+    /// first, comma-separated (e.g. 0.5,0.25,0.125). Each level continues from the
+    /// previous one, so level i+1 is a simplification of level i [default: off].
+    #[arg(
+        long,
+        value_delimiter = ',',
+        value_parser = parse_ratio,
+        conflicts_with_all = ["ratio", "triangles"],
+    )]
+    pub lods: Vec<f64>,
+    /// Write a JSON report of the run here (with --lods: one entry per level)
+    /// [default: no report].
+    #[arg(long, value_name = "REPORT.json")]
     pub report: Option<PathBuf>,
+    /// No progress bar and no summary line (errors are still printed).
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
-fn parse_ratio(s: &str) -> Result<f64, String> {
-    let r: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
-    if r > 0.0 && r <= 1.0 {
-        Ok(r)
+/// Runs `qem simplify`.
+pub fn run(args: &SimplifyArgs) -> Result<(), Failure> {
+    if args.lods.is_empty() {
+        run_single(args)
     } else {
-        Err(format!(
-            "{r} is outside (0, 1]; use e.g. 0.1 for 10% of the triangles"
-        ))
+        run_levels(args)
     }
 }
 
-fn parse_non_negative(s: &str) -> Result<f64, String> {
-    let v: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
-    if v >= 0.0 && v.is_finite() {
-        Ok(v)
-    } else {
-        Err(format!("{v} must be a finite number ≥ 0"))
+fn run_single(args: &SimplifyArgs) -> Result<(), Failure> {
+    if lossy(&args.output).contains(LOD_PLACEHOLDER) {
+        return Err(Failure::Usage(format!(
+            "{}: the output name contains {LOD_PLACEHOLDER} but --lods is not given; \
+             add e.g. --lods 0.5,0.25 or remove {LOD_PLACEHOLDER}",
+            args.output.display()
+        )));
     }
+    check_output_name(&args.output)?;
+    let bar = simplify_bar(bars_wanted(args.quiet), &file_name(&args.input));
+    let result = simplify_file(
+        &args.input,
+        &args.output,
+        &args.flags.options(),
+        &mut BarObserver::new(&bar),
+        false,
+    );
+    bar.finish_and_clear();
+    let json = result?;
+    if !args.quiet {
+        eprintln!("{}", json.summary_line());
+    }
+    if let Some(path) = &args.report {
+        write_json_atomically(path, &json).map_err(Failure::Failed)?;
+    }
+    Ok(())
 }
 
-impl SimplifyArgs {
-    fn length(&self, v: f64) -> Length {
-        if self.absolute {
-            Length::Absolute(v)
-        } else {
-            Length::DiagonalFraction(v)
+/// Loads `input`, simplifies it and writes `output` atomically; the report names both.
+/// Nothing is written (and with `create_dirs`, no missing directory of `output` is
+/// created) when loading or simplifying fails or Ctrl-C stops the run.
+pub fn simplify_file(
+    input: &Path,
+    output: &Path,
+    options: &SimplifyOptions,
+    observer: &mut dyn Observer,
+    create_dirs: bool,
+) -> Result<SimplifyJson, Failure> {
+    let (mesh, load) = load(input)?;
+    let clock = Instant::now();
+    let result = simplify_observed(&mesh, options, observer)
+        .map_err(|e| Failure::Failed(format!("{}: {e}", input.display())))?;
+    let simplify_time = clock.elapsed();
+    if result.report.stop_reason == StopReason::Cancelled || interrupted() {
+        return Err(Failure::Interrupted);
+    }
+    if create_dirs {
+        if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(|e| {
+                Failure::Failed(format!(
+                    "{}: cannot create the directory {}: {e}",
+                    output.display(),
+                    dir.display()
+                ))
+            })?;
         }
     }
-
-    /// The library options these arguments ask for.
-    pub fn options(&self) -> SimplifyOptions {
-        let target = match (self.triangles, self.ratio) {
-            (Some(n), _) => Target::Triangles(n),
-            (None, Some(r)) => Target::Ratio(r),
-            (None, None) => Target::Ratio(0.5),
-        };
-        SimplifyOptions::DEFAULT
-            .with_target(target)
-            .with_max_error(self.max_error.map(|e| self.length(e)))
-            .with_pair_threshold(self.length(self.pair_threshold))
-    }
+    let write = write(output, &result)?;
+    Ok(SimplifyJson::new(
+        input,
+        output,
+        &result.report,
+        load,
+        simplify_time,
+        write,
+    ))
 }
 
-/// Runs `qem simplify`; the error is the one-line message for stderr.
-pub fn run(args: &SimplifyArgs) -> Result<(), String> {
+fn load(input: &Path) -> Result<(qem_mesh::IndexedMesh, Duration), Failure> {
     let clock = Instant::now();
-    let loaded = read_path(&args.input).map_err(|e| e.to_string())?;
-    let load = clock.elapsed();
+    let loaded = read_path(input).map_err(|e| Failure::Failed(e.to_string()))?;
+    if interrupted() {
+        return Err(Failure::Interrupted);
+    }
+    Ok((loaded.mesh, clock.elapsed()))
+}
 
+fn write(output: &Path, result: &Simplified) -> Result<Duration, Failure> {
     let clock = Instant::now();
-    let result = simplify(&loaded.mesh, &args.options())
-        .map_err(|e| format!("{}: {e}", args.input.display()))?;
-    let simplify_time = clock.elapsed();
+    write_path(output, &result.mesh).map_err(|e| Failure::Failed(e.to_string()))?;
+    Ok(clock.elapsed())
+}
 
-    let clock = Instant::now();
-    write_path(&args.output, &result.mesh).map_err(|e| e.to_string())?;
-    let write = clock.elapsed();
+fn run_levels(args: &SimplifyArgs) -> Result<(), Failure> {
+    if let Some(w) = args.lods.windows(2).find(|w| w[1] >= w[0]) {
+        return Err(Failure::Usage(format!(
+            "--lods must decrease, but {} follows {}; list the levels largest first, \
+             e.g. --lods 0.5,0.25,0.125",
+            w[1], w[0]
+        )));
+    }
+    let pattern = lossy(&args.output);
+    if !pattern.contains(LOD_PLACEHOLDER) {
+        return Err(Failure::Usage(format!(
+            "{}: --lods writes one file per level, so the output name must contain \
+             {LOD_PLACEHOLDER} (it becomes 0, 1, 2, ...); e.g. -o out_{LOD_PLACEHOLDER}.obj",
+            args.output.display()
+        )));
+    }
+    let outputs: Vec<PathBuf> = (0..args.lods.len())
+        .map(|i| PathBuf::from(pattern.replace(LOD_PLACEHOLDER, &i.to_string())))
+        .collect();
+    for o in &outputs {
+        check_output_name(o)?;
+    }
 
-    if let Some(path) = &args.report {
-        let json = SimplifyJson::new(
+    let bar = simplify_bar(bars_wanted(args.quiet), &file_name(&args.input));
+    let result = (|| {
+        let (mesh, load) = load(&args.input)?;
+        let targets: Vec<Target> = args.lods.iter().map(|&r| Target::Ratio(r)).collect();
+        let clock = Instant::now();
+        let levels = simplify_levels(
+            &mesh,
+            &args.flags.options(),
+            &targets,
+            &mut BarObserver::new(&bar),
+        )
+        .map_err(|e| Failure::Failed(format!("{}: {e}", args.input.display())))?;
+        Ok((levels, load, clock.elapsed()))
+    })();
+    bar.finish_and_clear();
+    let (levels, load, simplify_time) = result?;
+    if interrupted()
+        || levels
+            .iter()
+            .any(|l| l.report.stop_reason == StopReason::Cancelled)
+    {
+        return Err(Failure::Interrupted);
+    }
+
+    let mut entries = Vec::with_capacity(levels.len());
+    for (lod, ((level, output), &ratio)) in levels.iter().zip(&outputs).zip(&args.lods).enumerate()
+    {
+        if interrupted() {
+            return Err(Failure::Interrupted);
+        }
+        let write = write(output, level)?;
+        let run = SimplifyJson::new(
             &args.input,
-            &args.output,
-            &result.report,
+            output,
+            &level.report,
             load,
             simplify_time,
             write,
         );
-        write_json_atomically(path, &json)?;
+        if !args.quiet {
+            eprintln!("level {lod} (ratio {ratio}): {}", run.summary_line());
+        }
+        entries.push(LevelJson { lod, ratio, run });
+    }
+    if let Some(path) = &args.report {
+        let json = LevelsJson {
+            input: args.input.display().to_string(),
+            levels: entries,
+        };
+        write_json_atomically(path, &json).map_err(Failure::Failed)?;
     }
     Ok(())
+}
+
+/// Refuses an output name whose format qem cannot write, or whose directory does not
+/// exist, before any work is done.
+fn check_output_name(output: &Path) -> Result<(), Failure> {
+    Format::from_path(output).map_err(|e| Failure::Failed(format!("{}: {e}", output.display())))?;
+    match output.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() && !dir.is_dir() => Err(Failure::Failed(format!(
+            "{}: the directory {} does not exist; create it first (e.g. mkdir -p {})",
+            output.display(),
+            dir.display(),
+            dir.display()
+        ))),
+        _ => Ok(()),
+    }
+}
+
+fn lossy(p: &Path) -> String {
+    p.as_os_str().to_string_lossy().into_owned()
+}
+
+fn file_name(p: &Path) -> String {
+    p.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| p.display().to_string())
 }

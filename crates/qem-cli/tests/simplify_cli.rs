@@ -1,5 +1,7 @@
 //! Runs the built `qem` binary as a user would.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -126,4 +128,59 @@ fn usage_errors_exit_2() {
     assert!(stderr(&o).contains("outside (0, 1]"), "{}", stderr(&o));
     let o = qem(&["simplify", "a.obj"]);
     assert_eq!(o.status.code(), Some(2));
+}
+
+#[test]
+fn missing_output_directory_fails_first_with_the_fix() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("not/there/o.obj");
+    let o = qem(&[
+        "simplify",
+        spot().to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let e = stderr(&o);
+    assert_eq!(e.lines().count(), 1, "{e}");
+    assert!(e.contains("o.obj: the directory"), "{e}");
+    assert!(e.contains("create it first"), "{e}");
+}
+
+/// Ctrl-C (SIGINT) during the contraction loop: exit 130, no output, no temporary file.
+#[cfg(unix)]
+#[test]
+fn ctrl_c_leaves_no_output() {
+    use std::process::Stdio;
+    use std::time::Duration;
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("big.ply");
+    qem_mesh::io::write_path(&input, &common::bumpy_grid(400, 1)).unwrap();
+    let out = dir.path().join("small.ply");
+    let child = Command::new(env!("CARGO_BIN_EXE_qem"))
+        .args([
+            "simplify",
+            input.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--ratio",
+            "0.001",
+        ])
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(700));
+    let killed = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
+    assert!(!out.exists());
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        1,
+        "only the input is left"
+    );
 }

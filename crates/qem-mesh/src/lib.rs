@@ -10,6 +10,7 @@
 
 pub mod clean;
 pub mod input;
+pub mod inspect;
 #[cfg(feature = "io")]
 pub mod io;
 pub mod measure;
