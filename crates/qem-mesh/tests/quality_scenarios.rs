@@ -1,0 +1,164 @@
+//! Named scenarios of the quality controls: fold-over and sliver checks, border planes
+//! and border locks, locked vertices.
+
+mod common;
+
+use common::{area, assert_valid, concat, grid, qualities, topology, uv_sphere};
+use qem_mesh::simplify::{
+    simplify, BoundaryMode, SimplifyError, SimplifyOptions, StopReason, Target,
+};
+use qem_mesh::IndexedMesh;
+
+fn at(ratio: f64) -> SimplifyOptions {
+    SimplifyOptions::DEFAULT.with_target(Target::Ratio(ratio))
+}
+
+/// A 30 x 30 sheet whose heights are deterministic noise of ±0.3 (units of the grid
+/// step): crumpled, so contractions often swing a face over its neighbours.
+fn jagged_sheet() -> IndexedMesh {
+    let mut sheet = grid(30, 30, 0.0);
+    for (i, p) in sheet.positions.iter_mut().enumerate() {
+        p[2] = (((i * 7919) % 101) as f64 / 101.0 - 0.5) * 0.6;
+    }
+    sheet
+}
+
+#[test]
+fn jagged_sheet_folds_over_without_the_check_and_not_with_it() {
+    let sheet = jagged_sheet();
+    let options = at(0.1).with_boundary(BoundaryMode::Free);
+    let unchecked = simplify(&sheet, &options.clone().with_max_normal_angle(180.0)).unwrap();
+    let checked = simplify(&sheet, &options).unwrap();
+    assert_valid(&checked.mesh, sheet.triangle_count());
+    // Measured: 6 faces of the unchecked result point more than 90° away from the face
+    // they descend from; none with the check, which refused 101 contractions.
+    assert!(unchecked.report.faces_flipped > 0);
+    assert_eq!(unchecked.report.rejected_flip, 0, "the check was off");
+    assert_eq!(checked.report.faces_flipped, 0);
+    assert!(checked.report.rejected_flip > 0);
+    assert_eq!(checked.report.stop_reason, StopReason::TargetReached);
+}
+
+/// A flat 20 x 20 sheet: every pair costs 0 with free borders, and the border is all
+/// that the quadrics could keep.
+fn flat_sheet() -> IndexedMesh {
+    grid(20, 20, 0.0)
+}
+
+#[test]
+fn flat_sheet_keeps_its_border_loop_and_area_with_border_planes() {
+    let sheet = flat_sheet();
+    let out = simplify(&sheet, &at(0.1)).unwrap();
+    assert_valid(&out.mesh, sheet.triangle_count());
+    assert!(out.mesh.triangle_count() <= 80);
+    assert_eq!(topology(&out.mesh).2, 1, "one border loop");
+    assert!(
+        (area(&out.mesh) - 400.0).abs() < 1e-6,
+        "area {}",
+        area(&out.mesh)
+    );
+    // Without border planes the sheet shrinks at zero cost: the same run keeps a
+    // tenth of the area.
+    let free = simplify(&sheet, &at(0.1).with_boundary(BoundaryMode::Free)).unwrap();
+    assert!(area(&free.mesh) < 100.0, "area {}", area(&free.mesh));
+}
+
+#[test]
+fn border_lock_keeps_every_border_vertex_bit_for_bit() {
+    let sheet = grid(16, 12, 0.3);
+    let out = simplify(&sheet, &at(0.2).with_boundary(BoundaryMode::Locked)).unwrap();
+    assert_valid(&out.mesh, sheet.triangle_count());
+    // 16 x 12 quads: 2·(17 + 13) − 4 = 56 border vertices.
+    assert_eq!(out.report.locked_vertices, 56);
+    for (i, p) in sheet.positions.iter().enumerate() {
+        let (x, y) = (i % 17, i / 17);
+        if x == 0 || x == 16 || y == 0 || y == 12 {
+            assert!(
+                out.mesh.positions.contains(p),
+                "border vertex {i} {p:?} moved or vanished"
+            );
+        }
+    }
+    assert_eq!(topology(&out.mesh).2, 1);
+}
+
+#[test]
+fn locked_vertices_stay_where_they_were() {
+    let sphere = uv_sphere([0.0; 3], 1.0, 16, 32);
+    let locked: Vec<u32> = (0..sphere.vertex_count() as u32).step_by(7).collect();
+    let out = simplify(&sphere, &at(0.1).with_locked_vertices(locked.clone())).unwrap();
+    assert_valid(&out.mesh, sphere.triangle_count());
+    assert_eq!(out.report.locked_vertices, locked.len());
+    for &i in &locked {
+        let p = sphere.positions[i as usize];
+        assert!(
+            out.mesh.positions.contains(&p),
+            "locked vertex {i} {p:?} moved or vanished"
+        );
+    }
+}
+
+#[test]
+fn locked_vertices_are_input_indices_before_welding() {
+    // Two triangles of an STL soup sharing an edge (6 vertices, 4 after welding), plus
+    // a far triangle so there is something to simplify. Locking input vertex 3 (a copy
+    // of vertex 1) locks the welded vertex.
+    let soup = concat(&[IndexedMesh::new(
+        vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.1],
+            [0.0, 1.0, 0.0],
+        ],
+        vec![[0, 1, 2], [3, 4, 5]],
+    )]);
+    let out = simplify(
+        &soup,
+        &SimplifyOptions::DEFAULT
+            .with_target(Target::Triangles(1))
+            .with_boundary(BoundaryMode::Free)
+            .with_locked_vertices(vec![3]),
+    )
+    .unwrap();
+    assert_eq!(out.report.locked_vertices, 1);
+    assert!(out.mesh.positions.contains(&[1.0, 0.0, 0.0]));
+}
+
+#[test]
+fn a_locked_index_out_of_range_is_a_clear_error() {
+    let sheet = grid(2, 2, 0.0);
+    let err = simplify(&sheet, &at(0.5).with_locked_vertices(vec![4, 9])).unwrap_err();
+    assert_eq!(
+        err,
+        SimplifyError::LockedVertexOutOfRange {
+            index: 9,
+            vertex_count: 9
+        }
+    );
+    assert!(err.to_string().contains("locked vertex 9"));
+}
+
+#[test]
+fn slivers_never_get_worse_than_the_threshold_or_the_input() {
+    // Each face's quality either stays above the threshold or does not decrease, so
+    // the output's worst face is at least min(threshold, input's worst face).
+    let sheet = jagged_sheet();
+    let min_in = qualities(&sheet).into_iter().fold(1.0, f64::min);
+    let threshold = 0.5;
+    let plain = simplify(&sheet, &at(0.1)).unwrap();
+    let min_plain = qualities(&plain.mesh).into_iter().fold(1.0, f64::min);
+    assert!(
+        min_plain < threshold,
+        "without the check slivers appear: {min_plain}"
+    );
+    let out = simplify(&sheet, &at(0.1).with_min_triangle_quality(threshold)).unwrap();
+    assert_valid(&out.mesh, sheet.triangle_count());
+    let min_out = qualities(&out.mesh).into_iter().fold(1.0, f64::min);
+    assert!(out.report.rejected_sliver > 0);
+    assert!(
+        min_out >= threshold.min(min_in),
+        "{min_out} < min({threshold}, {min_in})"
+    );
+}
