@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{area, assert_valid, concat, grid, qualities, topology, uv_sphere};
+use common::{area, assert_valid, grid, holed_grid, qualities, topology, uv_sphere};
 use qem_mesh::simplify::{
     simplify, BoundaryMode, SimplifyError, SimplifyOptions, StopReason, Target,
 };
@@ -30,8 +30,6 @@ fn jagged_sheet_folds_over_without_the_check_and_not_with_it() {
     let unchecked = simplify(&sheet, &options.clone().with_max_normal_angle(180.0)).unwrap();
     let checked = simplify(&sheet, &options).unwrap();
     assert_valid(&checked.mesh, sheet.triangle_count());
-    // Measured: 6 faces of the unchecked result point more than 90° away from the face
-    // they descend from; none with the check, which refused 101 contractions.
     assert!(unchecked.report.faces_flipped > 0);
     assert_eq!(unchecked.report.rejected_flip, 0, "the check was off");
     assert_eq!(checked.report.faces_flipped, 0);
@@ -100,30 +98,36 @@ fn locked_vertices_stay_where_they_were() {
 
 #[test]
 fn locked_vertices_are_input_indices_before_welding() {
-    // Two triangles of an STL soup sharing an edge (6 vertices, 4 after welding), plus
-    // a far triangle so there is something to simplify. Locking input vertex 3 (a copy
-    // of vertex 1) locks the welded vertex.
-    let soup = concat(&[IndexedMesh::new(
-        vec![
-            [0.0, 0.0, 0.0],
-            [1.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [1.0, 0.0, 0.0],
-            [1.0, 1.0, 0.1],
-            [0.0, 1.0, 0.0],
-        ],
-        vec![[0, 1, 2], [3, 4, 5]],
-    )]);
-    let out = simplify(
-        &soup,
-        &SimplifyOptions::DEFAULT
-            .with_target(Target::Triangles(1))
-            .with_boundary(BoundaryMode::Free)
-            .with_locked_vertices(vec![3]),
-    )
-    .unwrap();
+    // A square pyramid without its base as an STL soup: 4 triangles, 12 vertices, every
+    // position repeated (the apex 4 times). Whatever position the unlocked run removes,
+    // locking its *last* copy in the input (not the one welding keeps) keeps it.
+    let corners = [
+        [0.0, 0.0, 1.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, -1.0, 0.0],
+    ];
+    let faces = [[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1]];
+    let positions: Vec<[f64; 3]> = faces.iter().flatten().map(|&i| corners[i]).collect();
+    let soup = IndexedMesh::new(
+        positions.clone(),
+        vec![[0, 1, 2], [3, 4, 5], [6, 7, 8], [9, 10, 11]],
+    );
+    let options = SimplifyOptions::DEFAULT.with_target(Target::Triangles(2));
+    let unlocked = simplify(&soup, &options).unwrap();
+    assert_eq!(unlocked.report.cleanup.welded_vertices, 7);
+    let gone = corners
+        .iter()
+        .find(|p| !unlocked.mesh.positions.contains(p))
+        .expect("a contraction removed a corner");
+    let last_copy = positions.iter().rposition(|p| p == gone).unwrap();
+    let first_copy = positions.iter().position(|p| p == gone).unwrap();
+    assert_ne!(last_copy, first_copy);
+    let out = simplify(&soup, &options.with_locked_vertices(vec![last_copy as u32])).unwrap();
+    assert!(out.mesh.triangle_count() <= 2);
     assert_eq!(out.report.locked_vertices, 1);
-    assert!(out.mesh.positions.contains(&[1.0, 0.0, 0.0]));
+    assert!(out.mesh.positions.contains(gone), "{gone:?} was locked");
 }
 
 #[test]
@@ -161,4 +165,21 @@ fn slivers_never_get_worse_than_the_threshold_or_the_input() {
         min_out >= threshold.min(min_in),
         "{min_out} < min({threshold}, {min_in})"
     );
+}
+
+#[test]
+fn holes_survive_default_options_down_to_five_percent() {
+    // (A plane region with three border loops of 3 edges needs at least 11 triangles,
+    // so 5% = 24 triangles is about as low as the target can go.)
+    let holed = holed_grid();
+    assert_eq!(topology(&holed).2, 3);
+    for ratio in [0.1, 0.05] {
+        let out = simplify(&holed, &at(ratio)).unwrap();
+        assert_valid(&out.mesh, holed.triangle_count());
+        assert_eq!(topology(&out.mesh).2, 3, "ratio {ratio}: {:?}", out.report);
+        assert_eq!(out.report.stop_reason, StopReason::TargetReached);
+    }
+    // Free borders lose holes at 5%.
+    let free = simplify(&holed, &at(0.05).with_boundary(BoundaryMode::Free)).unwrap();
+    assert!(topology(&free.mesh).2 < 3, "{:?}", topology(&free.mesh));
 }

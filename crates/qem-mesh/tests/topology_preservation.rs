@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{assert_valid, concat, grid, topology, torus, uv_sphere};
+use common::{assert_valid, concat, grid, holed_grid, topology, torus, uv_sphere};
 use qem_mesh::clean::{clean, CleanOptions};
 use qem_mesh::simplify::{simplify, Length, SimplifyOptions, Target};
 use qem_mesh::IndexedMesh;
@@ -67,21 +67,7 @@ fn open_grid_keeps_one_border_loop() {
 
 #[test]
 fn grid_with_holes_keeps_every_hole() {
-    // A 16 x 16 grid with two 2 x 2 holes cut out: three border loops.
-    let g = grid(16, 16, 0.8);
-    let hole = |x: u32, y: u32, t: &[u32; 3]| {
-        let cell = |i: u32| (i % 17, i / 17);
-        let xs = t.map(|i| cell(i).0);
-        let ys = t.map(|i| cell(i).1);
-        xs.iter().all(|&cx| cx >= x && cx <= x + 2) && ys.iter().all(|&cy| cy >= y && cy <= y + 2)
-    };
-    let triangles = g
-        .triangles
-        .iter()
-        .copied()
-        .filter(|t| !hole(3, 3, t) && !hole(10, 9, t))
-        .collect();
-    let holed = IndexedMesh::new(g.positions.clone(), triangles);
+    let holed = holed_grid();
     assert_eq!(topology(&holed), (-1, 1, 3));
     assert_topology_kept("holed grid", &holed, &preserving(0.0));
 }

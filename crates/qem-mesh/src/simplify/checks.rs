@@ -18,6 +18,8 @@ pub(super) enum Rejection {
     Topology,
     /// Both ends are locked, or a locked vertex would lose its last face.
     Locked,
+    /// The contraction would pinch, close or remove a border loop.
+    Border,
 }
 
 /// `4√3·area / (l₀² + l₁² + l₂²)` from twice the area (`double_area`): 1 for an
@@ -41,6 +43,13 @@ impl Engine {
         world: DVec3,
     ) -> Result<(), Rejection> {
         self.fold_over(a, b, world)?;
+        if self.settings.keep_border_loops {
+            if let Some(ab) = ab {
+                if !self.keeps_border_loops(a, b, ab) {
+                    return Err(Rejection::Border);
+                }
+            }
+        }
         if self.settings.preserve_topology && !self.keeps_topology(a, b, ab) {
             return Err(Rejection::Topology);
         }
@@ -85,8 +94,12 @@ impl Engine {
                 }
                 let old_normal = (old[1] - old[0]).cross(old[2] - old[0]);
                 if let Some(min_cos) = self.settings.min_normal_cos {
-                    // cos(turn) = n_old·n_new / (|n_old| |n_new|), without dividing.
+                    // cos(turn) = n_old·n_new / (|n_old| |n_new|), without dividing. The
+                    // second test stops a face from turning away from the input face it
+                    // descends from in several small steps.
+                    let input_normal = self.original_normals.get(f).copied();
                     if old_normal.dot(new_normal) < min_cos * old_normal.length() * new_double_area
+                        || input_normal.is_some_and(|n| n.dot(new_normal) < 0.0)
                     {
                         verdict = Err(Rejection::Flip);
                         break 'vertices;
@@ -105,6 +118,37 @@ impl Engine {
         }
         self.face_scratch = faces;
         verdict
+    }
+
+    /// Whether contracting the edge `ab` keeps every border loop: when both ends are on
+    /// a border (an edge with one face), `ab` must be a border edge (otherwise two points
+    /// of the border, perhaps of two loops, are pinched together), and no third vertex
+    /// may be joined to both by border edges (that would close a loop of three edges,
+    /// or remove a lone triangle with its loop). Cheap when either end is interior: one
+    /// pass over each star.
+    fn keeps_border_loops(&self, a: VertexKey, b: VertexKey, ab: EdgeKey) -> bool {
+        let on_border = |v| {
+            self.store
+                .star(v)
+                .iter()
+                .any(|&e| self.store.fan(e).len() == 1)
+        };
+        if !on_border(a) || !on_border(b) {
+            return true;
+        }
+        if self.store.fan(ab).len() != 1 {
+            return false;
+        }
+        !self.store.star(a).iter().any(|&e| {
+            self.store.fan(e).len() == 1
+                && self.store.other_vertex(e, a).is_some_and(|x| {
+                    x != b
+                        && self
+                            .store
+                            .find_edge(b, x)
+                            .is_some_and(|bx| self.store.fan(bx).len() == 1)
+                })
+        })
     }
 
     /// The link condition of Dey, Edelsbrunner, Guha and Nekhayev ("Topology preserving

@@ -62,6 +62,7 @@ pub(super) struct Counters {
     pub rejected_sliver: usize,
     pub rejected_topology: usize,
     pub rejected_locked: usize,
+    pub rejected_border: usize,
     pub locked_vertices: usize,
 }
 
@@ -73,6 +74,7 @@ impl Counters {
             Rejection::Sliver => &mut self.rejected_sliver,
             Rejection::Topology => &mut self.rejected_topology,
             Rejection::Locked => &mut self.rejected_locked,
+            Rejection::Border => &mut self.rejected_border,
         };
         *counter += 1;
     }
@@ -91,6 +93,9 @@ pub(super) struct Settings {
     /// The sliver threshold; `None` when the check is off.
     pub min_quality: Option<f64>,
     pub preserve_topology: bool,
+    /// Refuse contractions that pinch, close or remove a border loop (any
+    /// [`BoundaryMode`] but `Free`).
+    pub keep_border_loops: bool,
     /// Whether any vertex is locked (skips the lock checks entirely when not).
     pub any_locked: bool,
 }
@@ -105,8 +110,9 @@ pub(super) struct Engine {
     pub counters: Counters,
     /// Intersection quadrics, with [`QuadricMode::Exact`] only.
     exact: Option<ExactQuadrics>,
-    /// The (unnormalised) normal of every input face, for [`Engine::flipped_faces`].
-    original_normals: SecondaryMap<FaceKey, DVec3>,
+    /// The (unnormalised) normal of every input face, for the fold-over check and
+    /// [`Engine::flipped_faces`].
+    pub original_normals: SecondaryMap<FaceKey, DVec3>,
     /// Reused buffer of the neighbours of a vertex and the edge to each.
     scratch: Vec<(VertexKey, Option<EdgeKey>)>,
     /// Reused buffer of the faces around a vertex.
@@ -127,6 +133,7 @@ impl Engine {
             min_quality: (options.min_triangle_quality > 0.0)
                 .then_some(options.min_triangle_quality),
             preserve_topology: options.preserve_topology,
+            keep_border_loops: options.boundary != BoundaryMode::Free,
             any_locked: false,
         };
         Engine {

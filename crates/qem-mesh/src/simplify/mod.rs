@@ -200,6 +200,7 @@ pub fn simplify_levels(
             rejected_sliver: counters.rejected_sliver,
             rejected_topology: counters.rejected_topology,
             rejected_locked: counters.rejected_locked,
+            rejected_border: counters.rejected_border,
             locked_vertices: counters.locked_vertices,
             faces_flipped: engine.flipped_faces(),
             timings,

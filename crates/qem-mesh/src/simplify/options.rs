@@ -70,10 +70,15 @@ pub enum BoundaryMode {
     /// like the face planes it competes with, so the weight is scale-free) and `w` with
     /// [`Weighting::Unweighted`]. Moving a border vertex off its border line then costs
     /// about `w` times as much as moving it the same distance off its faces' plane.
+    ///
+    /// Also the *loop rule*: an edge whose two ends are on a border must be a border
+    /// edge itself, and may not close a loop of three border edges, so border loops are
+    /// never pinched, merged or closed (counted in
+    /// [`SimplifyReport::rejected_border`](super::SimplifyReport::rejected_border)).
     Planes(f64),
     /// Border vertices never move and are never removed, like [locked
     /// vertices](SimplifyOptions::locked_vertices): the border comes out exactly as it
-    /// went in.
+    /// went in. The loop rule of [`Planes`](Self::Planes) applies too.
     Locked,
 }
 
@@ -142,7 +147,9 @@ pub struct SimplifyOptions {
     /// (see [`DEFAULT_BOUNDARY_WEIGHT`] for how it was chosen).
     pub boundary: BoundaryMode,
     /// Refuse a contraction that turns the normal of a surviving face by more than this
-    /// many degrees (a fold-over; 180 or more turns the check off). Counted in
+    /// many degrees, or that leaves it pointing more than 90° away from the input face
+    /// it descends from (a fold-over in several small steps); 180 or more turns the
+    /// check off (zero-area faces are refused regardless). Counted in
     /// [`SimplifyReport::rejected_flip`](super::SimplifyReport::rejected_flip).
     /// Default: [`DEFAULT_MAX_NORMAL_ANGLE`] degrees.
     pub max_normal_angle: f64,
@@ -171,16 +178,32 @@ pub struct SimplifyOptions {
     pub validate_each_contraction: bool,
 }
 
-/// The default border-plane weight of [`BoundaryMode::Planes`].
+/// The default border-plane weight of [`BoundaryMode::Planes`]: a border plane then
+/// weighs about as much as the faces around its edge together.
 ///
-/// Chosen by measurement (commit message of the quality branch, `qem simplify` at ratio
-/// 0.1 over corpus meshes with borders): TODO-MEASURED.
+/// Measured with `examples/quality_sweep.rs` on the 7 corpus meshes with borders (of
+/// 13), ratios 0.1 and 0.02, weights 0.1 to 100: no weight loses a border loop (the
+/// loop rule's doing, see [`BoundaryMode`]; one multipart mesh gains 2–4 loops where
+/// contractions tear it), while free borders lose loops on 3 of the 7; without planes the area
+/// shrinks by 5.2% (ratio 0.1) and 9.9% (0.02) on average, with weight 1 it changes by
+/// 0.8% and 6.0% (the lowest at 0.02; 0.77–0.81% for weights 0.5–100 at 0.1), while
+/// larger weights keep the border length closer (1.8% → 0.3% at 0.1) but shrink a
+/// multipart mesh's interior more at 0.02 (mean area change 9.5% at weight 100).
 pub const DEFAULT_BOUNDARY_WEIGHT: f64 = 1.0;
 
 /// The default of [`SimplifyOptions::max_normal_angle`], in degrees.
+///
+/// Measured on 13 corpus meshes at ratios 0.1 and 0.02: with the check at 90° no output
+/// face points away from its input face (without it: 2.0% and 2.4% on average, 18% on
+/// a CAD soup) and every run reaches its target; 60° and 45° also give 0% but one run
+/// of 13 stops short at 0.02, for no gain in error.
 pub const DEFAULT_MAX_NORMAL_ANGLE: f64 = 90.0;
 
-/// The default of [`SimplifyOptions::min_triangle_quality`].
+/// The default of [`SimplifyOptions::min_triangle_quality`]: off.
+///
+/// Measured on the same 13 meshes: 0.1 raises the largest error by 1.5x (geometric
+/// mean, ratio 0.1) and one run stops short of its target; the fold-over check alone
+/// already gives 0% flipped faces.
 pub const DEFAULT_MIN_TRIANGLE_QUALITY: f64 = 0.0;
 
 impl SimplifyOptions {

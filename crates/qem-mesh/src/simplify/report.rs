@@ -108,12 +108,18 @@ pub struct SimplifyReport {
     /// Contractions refused because both vertices were locked, or because a locked
     /// vertex would have lost its last face.
     pub rejected_locked: usize,
+    /// Contractions refused because they would have pinched, closed or removed a border
+    /// loop (with any [`BoundaryMode`](super::BoundaryMode) but `Free`).
+    pub rejected_border: usize,
     /// Vertices of the cleaned input that were locked (by
     /// [`locked_vertices`](super::SimplifyOptions::locked_vertices) or by
     /// [`BoundaryMode::Locked`](super::BoundaryMode::Locked)).
     pub locked_vertices: usize,
     /// Output faces whose normal points more than 90° away from the normal of the input
-    /// face they descend from (each output face is a moved input face).
+    /// face they descend from (each output face is a moved input face). The fold-over
+    /// check ([`max_normal_angle`](super::SimplifyOptions::max_normal_angle) below 180°)
+    /// refuses every contraction that would make one, so this is 0 unless the check is
+    /// off; it is a cheap self-check, not a comparison with the input surface.
     pub faces_flipped: usize,
     /// Wall time per phase.
     pub timings: Timings,

@@ -204,3 +204,21 @@ pub fn qualities(mesh: &IndexedMesh) -> Vec<f64> {
         })
         .collect()
 }
+
+/// A bumpy 16 x 16 grid with two 2 x 2 holes cut out: one part, three border loops.
+pub fn holed_grid() -> IndexedMesh {
+    let g = grid(16, 16, 0.8);
+    let in_hole = |x: u32, y: u32, t: &[u32; 3]| {
+        t.iter().all(|&i| {
+            let (cx, cy) = (i % 17, i / 17);
+            cx >= x && cx <= x + 2 && cy >= y && cy <= y + 2
+        })
+    };
+    let triangles = g
+        .triangles
+        .iter()
+        .copied()
+        .filter(|t| !in_hole(3, 3, t) && !in_hole(10, 9, t))
+        .collect();
+    IndexedMesh::new(g.positions, triangles)
+}
