@@ -33,6 +33,20 @@ fn quality(p0: DVec3, p1: DVec3, p2: DVec3, double_area: f64) -> f64 {
     }
 }
 
+/// Whether the normal turned from `old` to `new` by more than the angle whose cosine is
+/// `min_cos`: `old·new < min_cos·|old|·|new|`, compared in squares (`new_squared` is
+/// `|new|²`) so that no square root is taken.
+#[inline]
+fn turned_past(old: DVec3, new: DVec3, new_squared: f64, min_cos: f64) -> bool {
+    let dot = old.dot(new);
+    let bound = min_cos * min_cos * old.length_squared() * new_squared;
+    if min_cos >= 0.0 {
+        dot < 0.0 || dot * dot < bound
+    } else {
+        dot < 0.0 && dot * dot > bound
+    }
+}
+
 impl Engine {
     /// Every check of contracting `b` into `a` at `world` (`ab` is their edge, if any).
     pub(super) fn check(
@@ -87,18 +101,19 @@ impl Engine {
                     }
                 });
                 let new_normal = (new[1] - new[0]).cross(new[2] - new[0]);
-                let new_double_area = new_normal.length();
-                if new_double_area.is_nan() || new_double_area <= self.settings.min_double_area {
+                // Squared lengths throughout: no square root unless the sliver test runs.
+                let new_squared = new_normal.length_squared();
+                // A NaN area (only from overflow) is refused too.
+                if new_squared.is_nan() || new_squared <= self.settings.min_double_area_squared {
                     verdict = Err(Rejection::Degenerate);
                     break 'vertices;
                 }
                 let old_normal = (old[1] - old[0]).cross(old[2] - old[0]);
                 if let Some(min_cos) = self.settings.min_normal_cos {
-                    // cos(turn) = n_old·n_new / (|n_old| |n_new|), without dividing. The
-                    // second test stops a face from turning away from the input face it
-                    // descends from in several small steps.
+                    // The second test stops a face from turning away from the input face
+                    // it descends from in several small steps.
                     let input_normal = self.original_normals.get(f).copied();
-                    if old_normal.dot(new_normal) < min_cos * old_normal.length() * new_double_area
+                    if turned_past(old_normal, new_normal, new_squared, min_cos)
                         || input_normal.is_some_and(|n| n.dot(new_normal) < 0.0)
                     {
                         verdict = Err(Rejection::Flip);
@@ -106,7 +121,7 @@ impl Engine {
                     }
                 }
                 if let Some(min_quality) = self.settings.min_quality {
-                    let q_new = quality(new[0], new[1], new[2], new_double_area);
+                    let q_new = quality(new[0], new[1], new[2], new_squared.sqrt());
                     if q_new < min_quality
                         && q_new < quality(old[0], old[1], old[2], old_normal.length())
                     {
@@ -260,5 +275,26 @@ impl Engine {
         }
         self.face_scratch = faces;
         vanish
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::turned_past;
+    use qem_core::DVec3;
+
+    /// `turned_past` against the angle computed with `acos`.
+    #[test]
+    fn turned_past_matches_the_angle() {
+        let old = DVec3::new(0.0, 0.0, 2.0);
+        for degrees in [0.0f64, 30.0, 59.0, 61.0, 89.0, 91.0, 120.0, 179.0] {
+            let t = degrees.to_radians();
+            let new = DVec3::new(3.0 * t.sin(), 0.0, 3.0 * t.cos());
+            for limit in [45.0f64, 60.0, 90.0, 135.0] {
+                let expected = degrees > limit;
+                let got = turned_past(old, new, new.length_squared(), limit.to_radians().cos());
+                assert_eq!(got, expected, "{degrees}° against {limit}°");
+            }
+        }
     }
 }

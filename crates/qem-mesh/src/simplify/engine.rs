@@ -86,8 +86,9 @@ pub(super) struct Settings {
     pub placement: PlacementMode,
     /// The error bound in normalised units (infinite when there is none).
     pub max_error_bound: f64,
-    /// Twice the area at or below which a face counts as zero-area (normalised units).
-    pub min_double_area: f64,
+    /// The square of twice the area at or below which a face counts as zero-area
+    /// (normalised units), to compare with a cross product's squared length.
+    pub min_double_area_squared: f64,
     /// Cosine of the largest allowed normal turn; `None` when the check is off.
     pub min_normal_cos: Option<f64>,
     /// The sliver threshold; `None` when the check is off.
@@ -128,7 +129,7 @@ impl Engine {
         let settings = Settings {
             placement: options.placement,
             max_error_bound,
-            min_double_area: min_double_area(frame.normalized_diagonal()),
+            min_double_area_squared: min_double_area(frame.normalized_diagonal()).powi(2),
             min_normal_cos: (angle < 180.0).then(|| angle.to_radians().cos()),
             min_quality: (options.min_triangle_quality > 0.0)
                 .then_some(options.min_triangle_quality),
