@@ -3,9 +3,10 @@
 
 mod common;
 
-use common::{area, assert_valid, grid, holed_grid, qualities, topology, uv_sphere};
+use common::{area, assert_valid, concat, grid, holed_grid, qualities, topology, uv_sphere};
 use qem_mesh::simplify::{
-    simplify, BoundaryMode, SimplifyError, SimplifyOptions, StopReason, Target,
+    simplify, BoundaryMode, Length, SimplifyError, SimplifyOptions, StopReason, Target,
+    VirtualPairs,
 };
 use qem_mesh::IndexedMesh;
 
@@ -182,4 +183,47 @@ fn holes_survive_default_options_down_to_five_percent() {
     // Free borders lose holes at 5%.
     let free = simplify(&holed, &at(0.05).with_boundary(BoundaryMode::Free)).unwrap();
     assert!(topology(&free.mesh).2 < 3, "{:?}", topology(&free.mesh));
+}
+
+#[test]
+fn virtual_pairs_between_components_ignore_a_sheet_folded_onto_itself() {
+    // A 20 x 3 strip folded in two at x = 10: the second half lies 0.3 above the first.
+    //
+    //   z = 0.3   x=9 <------------ x=0   (columns 11..20)
+    //                \
+    //   z = 0     x=0 ------------> x=10  (columns 0..10)
+    let mut folded = grid(20, 3, 0.0);
+    for p in &mut folded.positions {
+        if p[0] > 10.0 {
+            *p = [20.0 - p[0], p[1], 0.3];
+        }
+    }
+    // The diagonal is about 10.4, so 5% of it (0.52) spans the 0.3 gap.
+    let options = at(0.5).with_pair_threshold(Length::DiagonalFraction(0.05));
+    let any = simplify(&folded, &options).unwrap();
+    assert!(any.report.virtual_pairs > 0);
+    let between = simplify(
+        &folded,
+        &options
+            .clone()
+            .with_virtual_pairs(VirtualPairs::BetweenComponents),
+    )
+    .unwrap();
+    assert_eq!(between.report.virtual_pairs, 0, "one component: no pair");
+    assert_eq!(between.report.virtual_contractions, 0);
+
+    // Cut at the fold, the two halves are two components, and pair up again.
+    let halves = concat(&[grid(10, 3, 0.0), {
+        let mut upper = grid(10, 3, 0.0);
+        for p in &mut upper.positions {
+            p[2] = 0.3;
+        }
+        upper
+    }]);
+    let parts = simplify(
+        &halves,
+        &options.with_virtual_pairs(VirtualPairs::BetweenComponents),
+    )
+    .unwrap();
+    assert!(parts.report.virtual_pairs > 0);
 }
