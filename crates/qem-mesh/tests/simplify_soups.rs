@@ -7,7 +7,8 @@ use common::assert_valid;
 use proptest::prelude::*;
 use qem_mesh::clean::{clean, CleanOptions};
 use qem_mesh::simplify::{
-    simplify, Length, PlacementMode, SimplifyError, SimplifyOptions, StopReason, Target,
+    simplify, BoundaryMode, Length, PlacementMode, QuadricMode, SimplifyError, SimplifyOptions,
+    StopReason, Target,
 };
 use qem_mesh::IndexedMesh;
 
@@ -21,23 +22,49 @@ fn soup(max_vertices: usize) -> impl Strategy<Value = IndexedMesh> {
     })
 }
 
+/// The quality controls in every combination (with random locked vertices, some out
+/// of range of the smaller soups, which must be the documented error).
+fn quality() -> impl Strategy<Value = (BoundaryMode, f64, f64, bool, QuadricMode, Vec<u32>)> {
+    (
+        prop_oneof![
+            Just(BoundaryMode::Free),
+            Just(BoundaryMode::Planes(1.0)),
+            Just(BoundaryMode::Locked)
+        ],
+        prop_oneof![Just(180.0), 10.0..180.0f64],
+        prop_oneof![Just(0.0), 0.0..0.5f64],
+        any::<bool>(),
+        prop_oneof![Just(QuadricMode::Sum), Just(QuadricMode::Exact)],
+        prop::collection::vec(0..32u32, 0..4),
+    )
+}
+
 fn options() -> impl Strategy<Value = SimplifyOptions> {
     (
         0.0..1.0f64,
         prop_oneof![Just(0.0), 0.0..0.5f64],
         any::<bool>(),
+        quality(),
     )
-        .prop_map(|(r, t, mid)| {
-            SimplifyOptions::DEFAULT
-                .with_target(Target::Ratio(r))
-                .with_pair_threshold(Length::DiagonalFraction(t))
-                .with_placement(if mid {
-                    PlacementMode::EndpointOrMidpoint
-                } else {
-                    PlacementMode::Optimal
-                })
-                .with_validate_each_contraction(true)
-        })
+        .prop_map(
+            |(r, t, mid, (boundary, angle, sliver, topology, quadrics, locked))| {
+                SimplifyOptions::DEFAULT
+                    .with_target(Target::Ratio(r))
+                    .with_pair_threshold(Length::DiagonalFraction(t))
+                    .with_placement(if mid {
+                        PlacementMode::EndpointOrMidpoint
+                    } else {
+                        PlacementMode::Optimal
+                    })
+                    .with_boundary(boundary)
+                    .with_max_normal_angle(angle)
+                    .with_min_triangle_quality(sliver)
+                    .with_preserve_topology(topology)
+                    .with_quadrics(quadrics)
+                    .with_locked_vertices(locked)
+                    .with_validate_each_contraction(true)
+            },
+        )
 }
 
 proptest! {
@@ -49,6 +76,10 @@ proptest! {
     fn messy_soups_give_valid_deterministic_output(mesh in soup(30), o in options()) {
         let first = simplify(&mesh, &o);
         match &first {
+            Err(SimplifyError::LockedVertexOutOfRange { index, vertex_count }) => {
+                prop_assert!(*index as usize >= mesh.vertex_count());
+                prop_assert_eq!(*vertex_count, mesh.vertex_count());
+            }
             Err(SimplifyError::NothingLeftAfterCleaning { .. }) => {
                 prop_assert!(clean(&mesh, &CleanOptions::DEFAULT).mesh.triangles.is_empty());
             }
@@ -64,9 +95,20 @@ proptest! {
                     prop_assert!(r.triangles_out <= r.target_triangles);
                 }
                 if let Length::DiagonalFraction(t) = o.pair_threshold {
-                    if t == 0.0 {
+                    if t == 0.0 || o.preserve_topology {
                         prop_assert_eq!(r.virtual_contractions, 0);
                     }
+                }
+                // Locked vertices (that cleaning kept) come out where they were.
+                let kept = clean(&mesh, &o.clean);
+                for &i in &o.locked_vertices {
+                    if kept.vertex_map[i as usize] != qem_mesh::clean::Cleaned::REMOVED {
+                        let p = mesh.positions[i as usize];
+                        prop_assert!(out.mesh.positions.contains(&p), "locked {i} {p:?} lost");
+                    }
+                }
+                if o.max_normal_angle < 180.0 {
+                    prop_assert_eq!(r.faces_flipped, 0);
                 }
             }
         }

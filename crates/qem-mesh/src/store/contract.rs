@@ -43,6 +43,35 @@ impl ContractOutcome {
     }
 }
 
+/// Which faces and edges one [`MeshStore::contract_logged`] removed, and into which
+/// survivor each merged one went, for callers that keep data per face or per edge (the
+/// exact quadrics of the simplifier sum the data of merged elements).
+///
+/// The vectors are cleared at the start of each logged contraction; keep one log and
+/// pass it to every call so that they stop allocating once warm.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct ContractLog {
+    /// Faces that contained both vertices and disappeared, in fan order of the edge
+    /// `a–b` (empty for a pair without an edge).
+    pub faces_collapsed: Vec<FaceKey>,
+    /// `(removed, kept)`: a face of `b` that became a copy of face `kept` of `a` and was
+    /// removed.
+    pub faces_merged: Vec<(FaceKey, FaceKey)>,
+    /// The edge `a–b`, if there was one; it is gone.
+    pub edge_collapsed: Option<EdgeKey>,
+    /// `(removed, kept)`: an edge `b–x` that merged into `a`'s edge `kept` to `x`.
+    pub edges_merged: Vec<(EdgeKey, EdgeKey)>,
+}
+
+impl ContractLog {
+    fn clear(&mut self) {
+        self.faces_collapsed.clear();
+        self.faces_merged.clear();
+        self.edge_collapsed = None;
+        self.edges_merged.clear();
+    }
+}
+
 /// Why [`MeshStore::contract`] refused; the store is unchanged.
 #[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
 #[non_exhaustive]
@@ -111,6 +140,53 @@ impl MeshStore {
         b: VertexKey,
         position: [f64; 3],
     ) -> Result<ContractOutcome, ContractError> {
+        self.contract_impl(a, b, position, None)
+    }
+
+    /// [`contract`](Self::contract) that also writes into `log` (cleared first) which
+    /// faces and edges were removed and which survivor each merged one went into.
+    ///
+    /// # Errors
+    /// As [`contract`](Self::contract); `log` is then cleared and the store unchanged.
+    ///
+    /// # Example
+    /// ```
+    /// use qem_mesh::{store::ContractLog, IndexedMesh, MeshStore};
+    ///
+    /// // The closed tetrahedron again: faces 0 and 1 are on edge 0-1 and collapse; face
+    /// // 3 (1 2 3) lands on face 2 (0 3 2) and merges.
+    /// let mesh = IndexedMesh::new(
+    ///     vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+    ///     vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+    /// );
+    /// let (mut store, keys) = MeshStore::from_mesh(&mesh)?;
+    /// let faces: Vec<_> = store.faces().collect();
+    /// let mut log = ContractLog::default();
+    /// store.contract_logged(keys[0], keys[1], [0.5, 0.0, 0.0], &mut log)?;
+    /// assert_eq!(log.faces_collapsed, vec![faces[0], faces[1]]);
+    /// assert_eq!(log.faces_merged, vec![(faces[3], faces[2])]);
+    /// assert!(log.edge_collapsed.is_some());
+    /// assert_eq!(log.edges_merged.len(), 2);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn contract_logged(
+        &mut self,
+        a: VertexKey,
+        b: VertexKey,
+        position: [f64; 3],
+        log: &mut ContractLog,
+    ) -> Result<ContractOutcome, ContractError> {
+        log.clear();
+        self.contract_impl(a, b, position, Some(log))
+    }
+
+    fn contract_impl(
+        &mut self,
+        a: VertexKey,
+        b: VertexKey,
+        position: [f64; 3],
+        mut log: Option<&mut ContractLog>,
+    ) -> Result<ContractOutcome, ContractError> {
         if a == b {
             return Err(ContractError::SameVertex(a));
         }
@@ -139,6 +215,10 @@ impl MeshStore {
             outcome.faces_collapsed = faces.len();
             self.remove_edge(ab);
             outcome.edge_collapsed = true;
+            if let Some(log) = log.as_deref_mut() {
+                log.faces_collapsed.extend_from_slice(&faces);
+                log.edge_collapsed = Some(ab);
+            }
         }
 
         // Step 2: faces of b move to a, or merge into a face of a.
@@ -150,9 +230,12 @@ impl MeshStore {
             };
             let x = face.vertices[(slot + 1) % 3];
             let y = face.vertices[(slot + 2) % 3];
-            if self.find_face(a, x, y).is_some() {
+            if let Some(kept) = self.find_face(a, x, y) {
                 self.remove_face(f);
                 outcome.faces_merged += 1;
+                if let Some(log) = log.as_deref_mut() {
+                    log.faces_merged.push((f, kept));
+                }
             } else {
                 self.faces[f].vertices[slot] = a;
             }
@@ -180,6 +263,9 @@ impl MeshStore {
                     remove_item(&mut self.vertices[x].star, &e);
                     self.edges.remove(e);
                     outcome.edges_merged += 1;
+                    if let Some(log) = log.as_deref_mut() {
+                        log.edges_merged.push((e, keep));
+                    }
                 }
                 None => {
                     self.edges[e].vertices = ordered(a, x);
@@ -195,8 +281,12 @@ impl MeshStore {
         Ok(outcome)
     }
 
-    /// The face on vertices `{a, x, y}` (any orientation), if any: a search of one fan.
-    pub(super) fn find_face(&self, a: VertexKey, x: VertexKey, y: VertexKey) -> Option<FaceKey> {
+    /// The face on vertices `{a, x, y}` (any orientation), if any: a search of one star
+    /// and one fan.
+    ///
+    /// # Panics
+    /// If `a` or `x` is not in the store.
+    pub fn find_face(&self, a: VertexKey, x: VertexKey, y: VertexKey) -> Option<FaceKey> {
         let e = self.find_edge(a, x)?;
         self.edges[e]
             .fan

@@ -50,7 +50,7 @@ mod query;
 mod validate;
 
 pub use build::BuildStats;
-pub use contract::{ContractError, ContractOutcome};
+pub use contract::{ContractError, ContractLog, ContractOutcome};
 pub use query::{EdgeClass, VertexClass};
 pub use validate::StoreError;
 

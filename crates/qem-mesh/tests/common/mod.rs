@@ -107,3 +107,118 @@ pub fn assert_valid(mesh: &IndexedMesh, triangles_in: usize) {
         "unreferenced vertex in output"
     );
 }
+
+/// Topological summary of a mesh as the store sees it: `(euler, components,
+/// border loops)`. The Euler characteristic is `V − E + F` over referenced vertices;
+/// border loops are the connected components of the graph of border edges (edges with
+/// one face), which on a manifold border are its loops.
+pub fn topology(mesh: &IndexedMesh) -> (i64, usize, usize) {
+    use qem_mesh::store::{EdgeClass, MeshStore};
+    let (store, _) = MeshStore::from_mesh(mesh).expect("a valid mesh");
+    let referenced = store
+        .vertices()
+        .filter(|&v| !store.star(v).is_empty())
+        .count();
+    let euler = referenced as i64 - store.edge_count() as i64 + store.face_count() as i64;
+    // Union-find over the ends of border edges.
+    let index: std::collections::HashMap<_, usize> =
+        store.vertices().enumerate().map(|(i, v)| (v, i)).collect();
+    let mut parent: Vec<usize> = (0..index.len()).collect();
+    fn find(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    let mut on_border = vec![false; index.len()];
+    for e in store.edges() {
+        if store.classify_edge(e) == EdgeClass::Boundary {
+            let [a, b] = store.edge_vertices(e).map(|v| index[&v]);
+            on_border[a] = true;
+            on_border[b] = true;
+            let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+            parent[ra] = rb;
+        }
+    }
+    let loops = (0..index.len())
+        .filter(|&i| on_border[i] && find(&mut parent, i) == i)
+        .count();
+    (euler, store.component_count(), loops)
+}
+
+/// A torus with `n` × `m` quads (major radius `big`, minor radius `small`).
+pub fn torus(big: f64, small: f64, n: u32, m: u32) -> IndexedMesh {
+    let mut positions = Vec::new();
+    for i in 0..n {
+        let u = 2.0 * std::f64::consts::PI * i as f64 / n as f64;
+        for j in 0..m {
+            let v = 2.0 * std::f64::consts::PI * j as f64 / m as f64;
+            let r = big + small * v.cos();
+            positions.push([r * u.cos(), r * u.sin(), small * v.sin()]);
+        }
+    }
+    let id = |i: u32, j: u32| (i % n) * m + j % m;
+    let mut triangles = Vec::new();
+    for i in 0..n {
+        for j in 0..m {
+            triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    IndexedMesh::new(positions, triangles)
+}
+
+/// Total area of the triangles.
+pub fn area(mesh: &IndexedMesh) -> f64 {
+    mesh.triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+            let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+            let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+            let cross = [
+                u[1] * v[2] - u[2] * v[1],
+                u[2] * v[0] - u[0] * v[2],
+                u[0] * v[1] - u[1] * v[0],
+            ];
+            0.5 * (cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]).sqrt()
+        })
+        .sum()
+}
+
+/// Quality `4√3·area / Σ l²` of every triangle (1 equilateral, 0 degenerate).
+pub fn qualities(mesh: &IndexedMesh) -> Vec<f64> {
+    mesh.triangles
+        .iter()
+        .map(|t| {
+            let one = IndexedMesh::new(
+                t.map(|i| mesh.positions[i as usize]).to_vec(),
+                vec![[0, 1, 2]],
+            );
+            let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+            let d2 = |p: [f64; 3], q: [f64; 3]| {
+                (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)
+            };
+            4.0 * 3f64.sqrt() * area(&one) / (d2(a, b) + d2(b, c) + d2(c, a))
+        })
+        .collect()
+}
+
+/// A bumpy 16 x 16 grid with two 2 x 2 holes cut out: one part, three border loops.
+pub fn holed_grid() -> IndexedMesh {
+    let g = grid(16, 16, 0.8);
+    let in_hole = |x: u32, y: u32, t: &[u32; 3]| {
+        t.iter().all(|&i| {
+            let (cx, cy) = (i % 17, i / 17);
+            cx >= x && cx <= x + 2 && cy >= y && cy <= y + 2
+        })
+    };
+    let triangles = g
+        .triangles
+        .iter()
+        .copied()
+        .filter(|t| !in_hole(3, 3, t) && !in_hole(10, 9, t))
+        .collect();
+    IndexedMesh::new(g.positions, triangles)
+}

@@ -1,0 +1,300 @@
+//! Which contractions are allowed: fold-over (degenerate, flipped and sliver faces),
+//! topology (the link condition) and locks. Cheapest first; none allocates.
+
+use super::engine::Engine;
+use crate::store::{EdgeClass, EdgeKey, VertexClass, VertexKey};
+use qem_core::DVec3;
+
+/// Why a contraction was refused (each has a counter in the report).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Rejection {
+    /// A surviving face would have (numerically) zero area.
+    Degenerate,
+    /// A surviving face's normal would turn past the allowed angle.
+    Flip,
+    /// A surviving face would become a sliver below the quality threshold.
+    Sliver,
+    /// The contraction would change the topology (or cannot be shown not to).
+    Topology,
+    /// Both ends are locked, or a locked vertex would lose its last face.
+    Locked,
+    /// The contraction would pinch, close or remove a border loop.
+    Border,
+}
+
+/// `4√3·area / (l₀² + l₁² + l₂²)` from twice the area (`double_area`): 1 for an
+/// equilateral triangle, 0 for a degenerate one.
+fn quality(p0: DVec3, p1: DVec3, p2: DVec3, double_area: f64) -> f64 {
+    let sum = p0.distance_squared(p1) + p1.distance_squared(p2) + p2.distance_squared(p0);
+    if sum > 0.0 {
+        2.0 * 3f64.sqrt() * double_area / sum
+    } else {
+        0.0
+    }
+}
+
+/// Whether the normal turned from `old` to `new` by more than the angle whose cosine is
+/// `min_cos`: `old·new < min_cos·|old|·|new|`, compared in squares (`new_squared` is
+/// `|new|²`) so that no square root is taken.
+#[inline]
+fn turned_past(old: DVec3, new: DVec3, new_squared: f64, min_cos: f64) -> bool {
+    let dot = old.dot(new);
+    let bound = min_cos * min_cos * old.length_squared() * new_squared;
+    if min_cos >= 0.0 {
+        dot < 0.0 || dot * dot < bound
+    } else {
+        dot < 0.0 && dot * dot > bound
+    }
+}
+
+impl Engine {
+    /// Every check of contracting `b` into `a` at `world` (`ab` is their edge, if any).
+    pub(super) fn check(
+        &mut self,
+        a: VertexKey,
+        b: VertexKey,
+        ab: Option<EdgeKey>,
+        world: DVec3,
+    ) -> Result<(), Rejection> {
+        self.fold_over(a, b, world)?;
+        if self.settings.keep_border_loops {
+            if let Some(ab) = ab {
+                if !self.keeps_border_loops(a, b, ab) {
+                    return Err(Rejection::Border);
+                }
+            }
+        }
+        if self.settings.preserve_topology && !self.keeps_topology(a, b, ab) {
+            return Err(Rejection::Topology);
+        }
+        if self.settings.any_locked && self.locked_vertex_would_vanish(a, b) {
+            return Err(Rejection::Locked);
+        }
+        Ok(())
+    }
+
+    /// Whether moving `a` and `b` to `world` would leave a surviving face of either
+    /// with (numerically) zero area, turn its normal past the threshold, or make it a
+    /// sliver worse than it was.
+    ///
+    /// Zero area is always refused: such a face would be dropped at output, and if it
+    /// were the last one the output would be empty. Why the sliver test also asks for
+    /// "worse than before": an input full of slivers (CAD exports) would otherwise
+    /// block every contraction near them, even those that improve them.
+    fn fold_over(&mut self, a: VertexKey, b: VertexKey, world: DVec3) -> Result<(), Rejection> {
+        let moved = self.frame.to_normalized(world);
+        let mut faces = std::mem::take(&mut self.face_scratch);
+        let mut verdict = Ok(());
+        'vertices: for v in [a, b] {
+            self.store.faces_of_vertex(v, &mut faces);
+            for &f in &faces {
+                let corners = self.store.face_vertices(f);
+                if corners.contains(&a) && corners.contains(&b) {
+                    continue; // collapses with the pair
+                }
+                let old = corners.map(|c| self.normalized_position(c));
+                let new = std::array::from_fn::<_, 3, _>(|i| {
+                    if corners[i] == a || corners[i] == b {
+                        moved
+                    } else {
+                        old[i]
+                    }
+                });
+                let new_normal = (new[1] - new[0]).cross(new[2] - new[0]);
+                // Squared lengths throughout: no square root unless the sliver test runs.
+                let new_squared = new_normal.length_squared();
+                // A NaN area (only from overflow) is refused too.
+                if new_squared.is_nan() || new_squared <= self.settings.min_double_area_squared {
+                    verdict = Err(Rejection::Degenerate);
+                    break 'vertices;
+                }
+                let old_normal = (old[1] - old[0]).cross(old[2] - old[0]);
+                if let Some(min_cos) = self.settings.min_normal_cos {
+                    // The second test stops a face from turning away from the input face
+                    // it descends from in several small steps.
+                    let input_normal = self.original_normals.get(f).copied();
+                    if turned_past(old_normal, new_normal, new_squared, min_cos)
+                        || input_normal.is_some_and(|n| n.dot(new_normal) < 0.0)
+                    {
+                        verdict = Err(Rejection::Flip);
+                        break 'vertices;
+                    }
+                }
+                if let Some(min_quality) = self.settings.min_quality {
+                    let q_new = quality(new[0], new[1], new[2], new_squared.sqrt());
+                    if q_new < min_quality
+                        && q_new < quality(old[0], old[1], old[2], old_normal.length())
+                    {
+                        verdict = Err(Rejection::Sliver);
+                        break 'vertices;
+                    }
+                }
+            }
+        }
+        self.face_scratch = faces;
+        verdict
+    }
+
+    /// Whether contracting the edge `ab` keeps every border loop: when both ends are on
+    /// a border (an edge with one face), `ab` must be a border edge (otherwise two points
+    /// of the border, perhaps of two loops, are pinched together), and no third vertex
+    /// may be joined to both by border edges (that would close a loop of three edges,
+    /// or remove a lone triangle with its loop). Cheap when either end is interior: one
+    /// pass over each star.
+    fn keeps_border_loops(&self, a: VertexKey, b: VertexKey, ab: EdgeKey) -> bool {
+        let on_border = |v| {
+            self.store
+                .star(v)
+                .iter()
+                .any(|&e| self.store.fan(e).len() == 1)
+        };
+        if !on_border(a) || !on_border(b) {
+            return true;
+        }
+        if self.store.fan(ab).len() != 1 {
+            return false;
+        }
+        !self.store.star(a).iter().any(|&e| {
+            self.store.fan(e).len() == 1
+                && self.store.other_vertex(e, a).is_some_and(|x| {
+                    x != b
+                        && self
+                            .store
+                            .find_edge(b, x)
+                            .is_some_and(|bx| self.store.fan(bx).len() == 1)
+                })
+        })
+    }
+
+    /// The link condition of Dey, Edelsbrunner, Guha and Nekhayev ("Topology preserving
+    /// edge contraction", 1999) on a 2-manifold with border, and a refusal elsewhere.
+    ///
+    /// For a border, their extension cones the border off with a dummy vertex ω (a
+    /// face `x y ω` for every border edge `x–y`) and asks the link condition of the
+    /// closed result. In terms of the real mesh, besides `Lk a ∩ Lk b = Lk ab`:
+    /// - ω is a common neighbour when `a` and `b` are both on a border, so `a–b` must be
+    ///   a border edge itself (otherwise the contraction pinches the border);
+    /// - `x ω` is a common link edge when `a–x` and `b–x` are both border edges, which
+    ///   would close a border loop of three edges (or collapse a lone triangle).
+    fn keeps_topology(&self, a: VertexKey, b: VertexKey, ab: Option<EdgeKey>) -> bool {
+        let Some(ab) = ab else {
+            return false; // a virtual pair joins parts or closes a gap
+        };
+        let border_edge = match self.store.classify_edge(ab) {
+            EdgeClass::Boundary => true,
+            EdgeClass::Manifold => false,
+            EdgeClass::Wire | EdgeClass::NonManifold => return false,
+        };
+        let on_border = |v| match self.store.classify_vertex(v) {
+            VertexClass::Interior => Some(false),
+            VertexClass::Boundary => Some(true),
+            VertexClass::Isolated | VertexClass::NonManifold => None,
+        };
+        let (Some(a_border), Some(b_border)) = (on_border(a), on_border(b)) else {
+            return false;
+        };
+        if a_border && b_border && !border_edge {
+            return false;
+        }
+        if !self.store.link_condition(a, b) {
+            return false;
+        }
+        if a_border && b_border {
+            for &e in self.store.star(a) {
+                if self.store.fan(e).len() != 1 {
+                    continue;
+                }
+                let Some(x) = self.store.other_vertex(e, a) else {
+                    continue;
+                };
+                if x != b
+                    && self
+                        .store
+                        .find_edge(b, x)
+                        .is_some_and(|bx| self.store.fan(bx).len() == 1)
+                {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+
+    /// Whether contracting `b` into `a` would leave a locked vertex without a face (it
+    /// would then be missing from the output): `a` itself, or a locked common neighbour
+    /// whose faces all collapse or merge.
+    fn locked_vertex_would_vanish(&mut self, a: VertexKey, b: VertexKey) -> bool {
+        let mut faces = std::mem::take(&mut self.face_scratch);
+        let mut vanish = false;
+        if self.state[a].locked {
+            // The merged vertex keeps every face of a or b that does not hold both. A
+            // face b x y that merges into a x y leaves a x y, so a has a face as soon
+            // as one of the two has a face without the other.
+            let mut left = 0usize;
+            for v in [a, b] {
+                self.store.faces_of_vertex(v, &mut faces);
+                let other = if v == a { b } else { a };
+                left += faces
+                    .iter()
+                    .filter(|&&f| !self.store.face_vertices(f).contains(&other))
+                    .count();
+            }
+            vanish = left == 0;
+        }
+        if !vanish {
+            for i in 0..self.store.star(a).len() {
+                let e = self.store.star(a)[i];
+                let Some(w) = self.store.other_vertex(e, a) else {
+                    continue;
+                };
+                if w == b || !self.state[w].locked || self.store.find_edge(b, w).is_none() {
+                    continue;
+                }
+                // w's faces on both a and b collapse; w b z merges when w a z exists.
+                self.store.faces_of_vertex(w, &mut faces);
+                let left = faces
+                    .iter()
+                    .filter(|&&f| {
+                        let c = self.store.face_vertices(f);
+                        let (has_a, has_b) = (c.contains(&a), c.contains(&b));
+                        if has_a && has_b {
+                            return false;
+                        }
+                        if has_b {
+                            let z = c.into_iter().find(|&v| v != w && v != b);
+                            return z.is_none_or(|z| self.store.find_face(w, a, z).is_none());
+                        }
+                        true
+                    })
+                    .count();
+                if left == 0 {
+                    vanish = true;
+                    break;
+                }
+            }
+        }
+        self.face_scratch = faces;
+        vanish
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::turned_past;
+    use qem_core::DVec3;
+
+    /// `turned_past` against the angle computed with `acos`.
+    #[test]
+    fn turned_past_matches_the_angle() {
+        let old = DVec3::new(0.0, 0.0, 2.0);
+        for degrees in [0.0f64, 30.0, 59.0, 61.0, 89.0, 91.0, 120.0, 179.0] {
+            let t = degrees.to_radians();
+            let new = DVec3::new(3.0 * t.sin(), 0.0, 3.0 * t.cos());
+            for limit in [45.0f64, 60.0, 90.0, 135.0] {
+                let expected = degrees > limit;
+                let got = turned_past(old, new, new.length_squared(), limit.to_radians().cos());
+                assert_eq!(got, expected, "{degrees}° against {limit}°");
+            }
+        }
+    }
+}

@@ -1,0 +1,547 @@
+//! The state of one run and the contraction loop itself.
+
+use super::checks::Rejection;
+use super::exact::ExactQuadrics;
+use super::observer::{Contraction, Observer, Progress};
+use super::options::{
+    BoundaryMode, PlacementMode, QuadricMode, SimplifyOptions, VirtualPairs, Weighting,
+};
+use super::report::{SimplifyError, StopReason};
+use crate::clean::min_double_area;
+use crate::pairs::grid::{virtual_pairs, GridOptions};
+use crate::queue::{Candidate, PairQueue};
+use crate::store::{EdgeKey, FaceKey, MeshStore, VertexKey};
+use crate::IndexedMesh;
+use qem_core::{
+    endpoint_placement, optimal_placement, DVec3, Frame, Placement, PlacementRule, Quadric,
+};
+use slotmap::SecondaryMap;
+use smallvec::SmallVec;
+
+/// How often (in contractions) the observer's progress is called.
+const OBSERVER_INTERVAL: usize = 4096;
+
+/// When the queue holds more than this many entries per live pair, stale entries are
+/// dropped. Why 2: a rebuild costs O(queue) and happens after at least as many pushes,
+/// so it adds O(1) amortised per push while keeping the heap within 2x of minimal.
+const STALE_REBUILD_FACTOR: usize = 2;
+
+/// Whether a queued pair still describes the two vertices as they are now.
+fn is_current(state: &SecondaryMap<VertexKey, VertexState>, c: &Candidate) -> bool {
+    match (state.get(c.a), state.get(c.b)) {
+        (Some(sa), Some(sb)) => sa.stamp == c.stamp_a && sb.stamp == c.stamp_b,
+        _ => false,
+    }
+}
+
+/// What the loop keeps per vertex.
+#[derive(Clone, Debug, Default)]
+pub(super) struct VertexState {
+    pub quadric: Quadric,
+    /// Bumped whenever the quadric or position changes; see [`crate::queue`].
+    pub stamp: u32,
+    /// Virtual-pair partners (vertices within t that share no edge).
+    pub partners: SmallVec<[VertexKey; 4]>,
+    /// Never moves, never disappears.
+    pub locked: bool,
+    /// Index in the cleaned mesh (for [`Contraction`] events).
+    pub index: u32,
+}
+
+/// What the report counts, accumulated over the run.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Counters {
+    pub edge_contractions: usize,
+    pub virtual_contractions: usize,
+    pub virtual_pairs: usize,
+    pub virtual_pairs_capped: usize,
+    /// The largest error contracted so far, normalised units.
+    pub max_error: f64,
+    pub rejected_degenerate: usize,
+    pub rejected_flip: usize,
+    pub rejected_sliver: usize,
+    pub rejected_topology: usize,
+    pub rejected_locked: usize,
+    pub rejected_border: usize,
+    pub locked_vertices: usize,
+}
+
+impl Counters {
+    fn reject(&mut self, why: Rejection) {
+        let counter = match why {
+            Rejection::Degenerate => &mut self.rejected_degenerate,
+            Rejection::Flip => &mut self.rejected_flip,
+            Rejection::Sliver => &mut self.rejected_sliver,
+            Rejection::Topology => &mut self.rejected_topology,
+            Rejection::Locked => &mut self.rejected_locked,
+            Rejection::Border => &mut self.rejected_border,
+        };
+        *counter += 1;
+    }
+}
+
+/// The options the loop reads, in the form it reads them.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Settings {
+    pub placement: PlacementMode,
+    /// The error bound in normalised units (infinite when there is none).
+    pub max_error_bound: f64,
+    /// The square of twice the area at or below which a face counts as zero-area
+    /// (normalised units), to compare with a cross product's squared length.
+    pub min_double_area_squared: f64,
+    /// Cosine of the largest allowed normal turn; `None` when the check is off.
+    pub min_normal_cos: Option<f64>,
+    /// The sliver threshold; `None` when the check is off.
+    pub min_quality: Option<f64>,
+    pub preserve_topology: bool,
+    /// Refuse contractions that pinch, close or remove a border loop (any
+    /// [`BoundaryMode`] but `Free`).
+    pub keep_border_loops: bool,
+    /// Whether any vertex is locked (skips the lock checks entirely when not).
+    pub any_locked: bool,
+}
+
+/// The state of one run of the contraction loop.
+pub(super) struct Engine {
+    pub store: MeshStore,
+    pub frame: Frame,
+    pub state: SecondaryMap<VertexKey, VertexState>,
+    queue: PairQueue,
+    pub settings: Settings,
+    pub counters: Counters,
+    /// Intersection quadrics, with [`QuadricMode::Exact`] only.
+    exact: Option<ExactQuadrics>,
+    /// The (unnormalised) normal of every input face, for the fold-over check and
+    /// [`Engine::flipped_faces`].
+    pub original_normals: SecondaryMap<FaceKey, DVec3>,
+    /// Reused buffer of the neighbours of a vertex and the edge to each.
+    scratch: Vec<(VertexKey, Option<EdgeKey>)>,
+    /// Reused buffer of the faces around a vertex.
+    pub face_scratch: Vec<FaceKey>,
+}
+
+impl Engine {
+    pub fn new(store: MeshStore, frame: Frame, options: &SimplifyOptions) -> Self {
+        let max_error_bound = options
+            .max_error
+            .map_or(f64::INFINITY, |e| e.normalized(&frame));
+        let angle = options.max_normal_angle.clamp(0.0, 180.0);
+        let settings = Settings {
+            placement: options.placement,
+            max_error_bound,
+            min_double_area_squared: min_double_area(frame.normalized_diagonal()).powi(2),
+            min_normal_cos: (angle < 180.0).then(|| angle.to_radians().cos()),
+            min_quality: (options.min_triangle_quality > 0.0)
+                .then_some(options.min_triangle_quality),
+            preserve_topology: options.preserve_topology,
+            keep_border_loops: options.boundary != BoundaryMode::Free,
+            any_locked: false,
+        };
+        Engine {
+            state: SecondaryMap::with_capacity(store.vertex_count()),
+            queue: PairQueue::with_capacity(store.edge_count() * 2),
+            exact: (options.quadrics == QuadricMode::Exact).then(|| ExactQuadrics::new(&store)),
+            original_normals: SecondaryMap::with_capacity(store.face_count()),
+            store,
+            frame,
+            settings,
+            counters: Counters::default(),
+            scratch: Vec::new(),
+            face_scratch: Vec::new(),
+        }
+    }
+
+    pub fn normalized_position(&self, v: VertexKey) -> DVec3 {
+        self.frame
+            .to_normalized(DVec3::from_array(self.store.position(v)))
+    }
+
+    /// Face quadrics summed into vertex quadrics, border planes or locks, locked
+    /// vertices, virtual pairs, and the first queue. `keys[i]` is the store's key of the
+    /// cleaned mesh's vertex `i`; `locked` lists cleaned-mesh indices.
+    pub fn initialise(
+        &mut self,
+        cleaned: &IndexedMesh,
+        keys: &[VertexKey],
+        locked: &[u32],
+        options: &SimplifyOptions,
+    ) {
+        for (i, &v) in keys.iter().enumerate() {
+            self.state.insert(
+                v,
+                VertexState {
+                    index: i as u32,
+                    ..VertexState::default()
+                },
+            );
+        }
+        let faces: Vec<_> = self.store.faces().collect();
+        for f in faces {
+            let [a, b, c] = self.store.face_vertices(f);
+            let (pa, pb, pc) = (
+                self.normalized_position(a),
+                self.normalized_position(b),
+                self.normalized_position(c),
+            );
+            self.original_normals.insert(f, (pb - pa).cross(pc - pa));
+            let q = match options.weighting {
+                Weighting::Area => Quadric::from_triangle(pa, pb, pc),
+                Weighting::Unweighted => Quadric::from_triangle_unweighted(pa, pb, pc),
+            };
+            for v in [a, b, c] {
+                if let Some(s) = self.state.get_mut(v) {
+                    s.quadric += q;
+                }
+            }
+            if let Some(exact) = &mut self.exact {
+                exact.add_face(f, self.store.face_edges(f), q);
+            }
+        }
+        self.initialise_boundary(options);
+        for &i in locked {
+            if let Some(s) = keys.get(i as usize).and_then(|&v| self.state.get_mut(v)) {
+                s.locked = true;
+            }
+        }
+        self.counters.locked_vertices = self.state.values().filter(|s| s.locked).count();
+        self.settings.any_locked = self.counters.locked_vertices > 0;
+
+        let threshold = if options.preserve_topology {
+            0.0 // joining parts changes the topology
+        } else {
+            options.pair_threshold.normalized(&self.frame)
+        };
+        if threshold > 0.0 {
+            self.initialise_virtual_pairs(cleaned, keys, threshold, options);
+        }
+
+        let edges: Vec<_> = self.store.edges().collect();
+        for e in edges {
+            let [a, b] = self.store.edge_vertices(e);
+            self.push_pair(a, b, Some(e));
+        }
+    }
+
+    /// Border planes ([`BoundaryMode::Planes`]) or border locks ([`BoundaryMode::Locked`]).
+    fn initialise_boundary(&mut self, options: &SimplifyOptions) {
+        let weight = match options.boundary {
+            BoundaryMode::Free => return,
+            BoundaryMode::Planes(w) if w > 0.0 && w.is_finite() => Some(w),
+            BoundaryMode::Planes(_) => return,
+            BoundaryMode::Locked => None,
+        };
+        let borders: Vec<EdgeKey> = self
+            .store
+            .edges()
+            .filter(|&e| self.store.fan(e).len() == 1)
+            .collect();
+        for e in borders {
+            let [a, b] = self.store.edge_vertices(e);
+            let Some(w) = weight else {
+                for v in [a, b] {
+                    if let Some(s) = self.state.get_mut(v) {
+                        s.locked = true;
+                    }
+                }
+                continue;
+            };
+            let f = self.store.fan(e)[0];
+            let [p0, p1, p2] = self
+                .store
+                .face_vertices(f)
+                .map(|v| self.normalized_position(v));
+            let normal = (p1 - p0).cross(p2 - p0).normalize_or_zero();
+            let (pa, pb) = (self.normalized_position(a), self.normalized_position(b));
+            let plane_weight = match options.weighting {
+                Weighting::Area => w * pa.distance_squared(pb),
+                Weighting::Unweighted => w,
+            };
+            let q = Quadric::boundary_constraint(pa, pb, normal, plane_weight);
+            for v in [a, b] {
+                if let Some(s) = self.state.get_mut(v) {
+                    s.quadric += q;
+                }
+            }
+            if let Some(exact) = &mut self.exact {
+                exact.add_edge_plane(e, q);
+            }
+        }
+    }
+
+    /// Virtual pairs from the grid, filtered by [`VirtualPairs`], queued.
+    fn initialise_virtual_pairs(
+        &mut self,
+        cleaned: &IndexedMesh,
+        keys: &[VertexKey],
+        threshold: f64,
+        options: &SimplifyOptions,
+    ) {
+        let normalized: Vec<[f64; 3]> = cleaned
+            .positions
+            .iter()
+            .map(|p| self.frame.to_normalized(DVec3::from_array(*p)).to_array())
+            .collect();
+        let labels = match options.virtual_pairs {
+            VirtualPairs::Any => None,
+            VirtualPairs::BetweenComponents => Some(self.store.component_labels()),
+        };
+        let store = &self.store;
+        let grid =
+            GridOptions::new(threshold).with_max_per_vertex(options.max_virtual_pairs_per_vertex);
+        let found = virtual_pairs(&normalized, &grid, |i, j| {
+            let (a, b) = (keys[i as usize], keys[j as usize]);
+            let separate = labels.as_ref().is_none_or(|l| l.get(a) != l.get(b));
+            separate && store.find_edge(a, b).is_none()
+        });
+        self.counters.virtual_pairs = found.pairs.len();
+        self.counters.virtual_pairs_capped = found.capped;
+        for (i, j) in found.pairs {
+            let (a, b) = (keys[i as usize], keys[j as usize]);
+            if let Some(s) = self.state.get_mut(a) {
+                s.partners.push(b);
+            }
+            if let Some(s) = self.state.get_mut(b) {
+                s.partners.push(a);
+            }
+            self.push_pair(a, b, None);
+        }
+    }
+
+    /// The merged quadric of `a` and `b` (joined by edge `ab`, if any), where the new
+    /// vertex would go and its cost, in normalised units. A locked end stays put.
+    fn place(&self, a: VertexKey, b: VertexKey, ab: Option<EdgeKey>) -> (Placement, Quadric) {
+        let (sa, sb) = (&self.state[a], &self.state[b]);
+        let mut q = sa.quadric + sb.quadric;
+        if let Some(exact) = &self.exact {
+            q -= exact.edge(ab);
+        }
+        let fixed = if sa.locked {
+            Some((a, PlacementRule::FirstEnd))
+        } else if sb.locked {
+            Some((b, PlacementRule::SecondEnd))
+        } else {
+            None
+        };
+        if let Some((v, rule)) = fixed {
+            let position = self.normalized_position(v);
+            let cost = q.evaluate(position).max(0.0);
+            return (
+                Placement {
+                    position,
+                    cost,
+                    rule,
+                },
+                q,
+            );
+        }
+        let (pa, pb) = (self.normalized_position(a), self.normalized_position(b));
+        let placed = match self.settings.placement {
+            PlacementMode::Optimal => optimal_placement(&q, pa, pb),
+            PlacementMode::EndpointOrMidpoint => endpoint_placement(&q, pa, pb),
+        };
+        (placed, q)
+    }
+
+    fn push_pair(&mut self, a: VertexKey, b: VertexKey, ab: Option<EdgeKey>) {
+        let (placed, _) = self.place(a, b, ab);
+        self.queue.push(Candidate {
+            cost: placed.cost,
+            a,
+            b,
+            stamp_a: self.state[a].stamp,
+            stamp_b: self.state[b].stamp,
+        });
+    }
+
+    pub fn run(
+        &mut self,
+        target: usize,
+        options: &SimplifyOptions,
+        observer: &mut dyn Observer,
+    ) -> Result<StopReason, SimplifyError> {
+        let start = self.store.face_count();
+        let mut since_report = 0usize;
+        let reason = loop {
+            if self.store.face_count() <= target {
+                break StopReason::TargetReached;
+            }
+            let Some(candidate) = self.queue.pop() else {
+                break StopReason::NoValidPair;
+            };
+            if !is_current(&self.state, &candidate) {
+                continue;
+            }
+            let (mut a, mut b) = (candidate.a, candidate.b);
+            // Cheapest checks first: locks are two flags.
+            let (locked_a, locked_b) = (self.state[a].locked, self.state[b].locked);
+            if locked_a && locked_b {
+                self.counters.reject(Rejection::Locked);
+                continue;
+            }
+            if locked_b {
+                // The locked vertex is the one that stays.
+                std::mem::swap(&mut a, &mut b);
+            }
+            let ab = self.store.find_edge(a, b);
+            // Never contract the last faces away: the output must keep a triangle.
+            let shared_faces = ab.map_or(0, |e| self.store.fan(e).len());
+            if shared_faces >= self.store.face_count() {
+                continue;
+            }
+            let (placed, q) = self.place(a, b, ab);
+            let error = q.rms_distance(placed.cost);
+            if error > self.settings.max_error_bound {
+                break StopReason::MaxErrorReached;
+            }
+            let world = if locked_a || locked_b {
+                // Bit for bit where it was, not a round trip through the frame.
+                DVec3::from_array(self.store.position(a))
+            } else {
+                self.world_position(&placed, a)
+            };
+            if let Err(why) = self.check(a, b, ab, world) {
+                self.counters.reject(why);
+                continue;
+            }
+            let kept = self.state[a].index;
+            let removed = self.state[b].index;
+            self.contract(a, b, ab, world, q);
+            self.counters.max_error = self.counters.max_error.max(error);
+            observer.contracted(&Contraction {
+                kept,
+                removed,
+                is_virtual: ab.is_none(),
+                quadric: q,
+                position: placed.position,
+                cost: placed.cost,
+            });
+            if options.validate_each_contraction {
+                self.store.validate().map_err(SimplifyError::Internal)?;
+            }
+
+            // Each contraction queues a fresh entry per neighbour and leaves the old
+            // ones stale; once stale entries dominate, drop them in one O(n) pass so
+            // the heap (and every pop) stays proportional to the live pairs.
+            if self.queue.len()
+                > STALE_REBUILD_FACTOR * (self.store.edge_count() + self.counters.virtual_pairs)
+                    + 1024
+            {
+                let state = &self.state;
+                self.queue.retain(|c| is_current(state, c));
+            }
+
+            since_report += 1;
+            if since_report == OBSERVER_INTERVAL {
+                since_report = 0;
+                observer.progress(Progress {
+                    triangles: self.store.face_count(),
+                    triangles_start: start,
+                    target,
+                });
+                if observer.should_stop() {
+                    break StopReason::Cancelled;
+                }
+            }
+        };
+        observer.progress(Progress {
+            triangles: self.store.face_count(),
+            triangles_start: start,
+            target,
+        });
+        Ok(reason)
+    }
+
+    /// The world position of a placement; a non-finite one (possible only when the
+    /// mesh spans nearly all of f64) falls back to `a`'s position.
+    fn world_position(&self, placed: &Placement, a: VertexKey) -> DVec3 {
+        let world = self.frame.to_world(placed.position);
+        if world.is_finite() {
+            world
+        } else {
+            DVec3::from_array(self.store.position(a))
+        }
+    }
+
+    /// Contracts `b` into `a` at `world`, merges their state, and queues the new pairs.
+    fn contract(
+        &mut self,
+        a: VertexKey,
+        b: VertexKey,
+        ab: Option<EdgeKey>,
+        world: DVec3,
+        q: Quadric,
+    ) {
+        if ab.is_some() {
+            self.counters.edge_contractions += 1;
+        } else {
+            self.counters.virtual_contractions += 1;
+        }
+        // Both keys are live (checked by is_current) and distinct (pairs are built from
+        // edges and from distinct grid points), so contraction cannot fail.
+        let contracted = match &mut self.exact {
+            Some(exact) => exact.contract(&mut self.store, a, b, ab, world.to_array()),
+            None => self.store.contract(a, b, world.to_array()).map(|_| ()),
+        };
+        if contracted.is_err() {
+            return;
+        }
+
+        // Merge b's virtual partners into a's, re-pointing the partners' lists.
+        let b_state = self.state.remove(b).unwrap_or_default();
+        for &p in &b_state.partners {
+            if let Some(ps) = self.state.get_mut(p) {
+                ps.partners.retain(|x| *x != b);
+                if p != a && !ps.partners.contains(&a) {
+                    ps.partners.push(a);
+                }
+            }
+        }
+        let mut partners = std::mem::take(&mut self.state[a].partners);
+        partners.retain(|x| *x != b);
+        for &p in &b_state.partners {
+            if p != a && !partners.contains(&p) {
+                partners.push(p);
+            }
+        }
+        // A virtual pair that became an edge is an edge from now on.
+        let store = &self.store;
+        partners.retain(|p| store.contains_vertex(*p) && store.find_edge(a, *p).is_none());
+        let sa = &mut self.state[a];
+        sa.partners = partners;
+        sa.quadric = q;
+        sa.stamp = sa.stamp.wrapping_add(1);
+
+        // Re-cost every pair around the new vertex.
+        let mut neighbours = std::mem::take(&mut self.scratch);
+        neighbours.clear();
+        neighbours.extend(
+            self.store
+                .star(a)
+                .iter()
+                .filter_map(|&e| self.store.other_vertex(e, a).map(|n| (n, Some(e)))),
+        );
+        neighbours.extend(self.state[a].partners.iter().map(|&p| (p, None)));
+        for &(n, e) in &neighbours {
+            self.push_pair(a, n, e);
+        }
+        self.scratch = neighbours;
+    }
+
+    /// Faces whose normal now points more than 90° from the input face they descend
+    /// from (a merged face counts as the face that was kept).
+    pub fn flipped_faces(&self) -> usize {
+        self.store
+            .faces()
+            .filter(|&f| {
+                let [p0, p1, p2] = self
+                    .store
+                    .face_vertices(f)
+                    .map(|v| self.normalized_position(v));
+                let now = (p1 - p0).cross(p2 - p0);
+                self.original_normals
+                    .get(f)
+                    .is_some_and(|was| now.dot(*was) < 0.0)
+            })
+            .count()
+    }
+}

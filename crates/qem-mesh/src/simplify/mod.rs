@@ -1,0 +1,221 @@
+//! The contraction loop: Garland–Heckbert pair contraction on any triangle input.
+//!
+//! validate → clean → build the store → face quadrics → vertex quadrics (+ border
+//! planes) → candidate pairs (every edge, plus virtual pairs closer than t) → queue →
+//! loop { pop the cheapest; skip it if stale; stop on the target or the error bound;
+//! check it (locks, fold-over, topology); contract; merge the quadrics; re-cost the
+//! pairs around the new vertex } → compact → report.
+//!
+//! Quadrics are computed in the normalised [`Frame`] of the cleaned input (coordinates
+//! in `[-1, 1]`), while the store keeps world coordinates, so vertices that are never
+//! moved come out bit for bit as they went in.
+//!
+//! Submodules, one job each: `options` (what a run may do), `report` (what it did),
+//! `observer` (progress, cancellation, per-contraction events), `engine` (the loop),
+//! `checks` (which contractions are allowed), `exact` (the inclusion–exclusion
+//! bookkeeping of [`QuadricMode::Exact`]).
+
+mod checks;
+mod engine;
+mod exact;
+mod observer;
+mod options;
+mod report;
+
+pub use observer::{Contraction, NoObserver, Observer, Progress};
+pub use options::{
+    BoundaryMode, Length, PlacementMode, QuadricMode, SimplifyOptions, Target, VirtualPairs,
+    Weighting, DEFAULT_BOUNDARY_WEIGHT, DEFAULT_MAX_NORMAL_ANGLE, DEFAULT_MIN_TRIANGLE_QUALITY,
+};
+pub use report::{Simplified, SimplifyError, SimplifyReport, StopReason, Timings};
+
+use crate::clean::{clean, CleanOptions, Cleaned};
+use crate::store::MeshStore;
+use crate::IndexedMesh;
+use engine::Engine;
+use qem_core::{DVec3, Frame};
+use std::time::Instant;
+
+/// Simplifies `mesh` with `options`.
+///
+/// The output is always valid: every index in range, no face with a repeated vertex,
+/// no zero-area face, finite coordinates, never more triangles than the input; and the
+/// same input and options give the same output bit for bit.
+///
+/// ```
+/// use qem_mesh::simplify::{simplify, SimplifyOptions, Target, StopReason};
+/// use qem_mesh::IndexedMesh;
+/// // A square pyramid without its base: 4 triangles around an apex.
+/// let mesh = IndexedMesh::new(
+///     vec![[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]],
+///     vec![[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1]],
+/// );
+/// let out = simplify(&mesh, &SimplifyOptions::DEFAULT.with_target(Target::Triangles(2)))?;
+/// assert!(out.mesh.triangle_count() <= 2);
+/// assert_eq!(out.report.stop_reason, StopReason::TargetReached);
+/// # Ok::<(), qem_mesh::simplify::SimplifyError>(())
+/// ```
+pub fn simplify(
+    mesh: &IndexedMesh,
+    options: &SimplifyOptions,
+) -> Result<Simplified, SimplifyError> {
+    simplify_observed(mesh, options, &mut NoObserver)
+}
+
+/// [`simplify`] with an observer for progress and cancellation.
+pub fn simplify_observed(
+    mesh: &IndexedMesh,
+    options: &SimplifyOptions,
+    observer: &mut dyn Observer,
+) -> Result<Simplified, SimplifyError> {
+    let mut levels = simplify_levels(mesh, options, &[options.target], observer)?;
+    // One target in, one level out (simplify_levels returns one result per target).
+    levels.pop().ok_or(SimplifyError::NothingLeftAfterCleaning {
+        triangles_in: mesh.triangle_count(),
+    })
+}
+
+/// A chain of levels of detail from one run: the loop contracts down to `levels[0]`,
+/// takes a copy of the mesh, then *continues* from there to `levels[1]`, and so on, so
+/// each level is a simplification of the previous one and the whole chain costs about
+/// as much as the coarsest level alone. `options.target` is ignored; every other option
+/// applies to every level.
+///
+/// Returns one [`Simplified`] per entry of `levels`, in order. Each level's report
+/// describes the run up to that level: contraction counts and `max_error` are
+/// cumulative, `timings.contract` is the loop time so far and `timings.compact` that
+/// level's copy. Levels whose target is above the count already reached repeat the
+/// previous mesh (with [`StopReason::TargetReached`]); once the loop stops short
+/// (error bound, no pair, cancelled), the later levels repeat the last mesh with the
+/// same stop reason.
+///
+/// ```
+/// use qem_mesh::simplify::{simplify_levels, NoObserver, SimplifyOptions, Target};
+/// use qem_mesh::IndexedMesh;
+/// // A 4x4 grid of squares, 32 triangles.
+/// let n = 5;
+/// let positions = (0..n * n).map(|i| [(i % n) as f64, (i / n) as f64, ((i * 7) % 3) as f64]).collect();
+/// let mut triangles = Vec::new();
+/// for y in 0..n - 1 {
+///     for x in 0..n - 1 {
+///         let v = (y * n + x) as u32;
+///         triangles.push([v, v + 1, v + n as u32]);
+///         triangles.push([v + 1, v + n as u32 + 1, v + n as u32]);
+///     }
+/// }
+/// let mesh = IndexedMesh::new(positions, triangles);
+/// let levels = [Target::Ratio(0.5), Target::Ratio(0.25)];
+/// let out = simplify_levels(&mesh, &SimplifyOptions::DEFAULT, &levels, &mut NoObserver)?;
+/// assert_eq!(out.len(), 2);
+/// assert!(out[0].mesh.triangle_count() <= 16);
+/// assert!(out[1].mesh.triangle_count() <= out[0].mesh.triangle_count());
+/// # Ok::<(), qem_mesh::simplify::SimplifyError>(())
+/// ```
+pub fn simplify_levels(
+    mesh: &IndexedMesh,
+    options: &SimplifyOptions,
+    levels: &[Target],
+    observer: &mut dyn Observer,
+) -> Result<Vec<Simplified>, SimplifyError> {
+    let mut timings = Timings::default();
+    let clock = Instant::now();
+    mesh.validate()?;
+    if let Some(&index) = options
+        .locked_vertices
+        .iter()
+        .find(|&&i| i as usize >= mesh.vertex_count())
+    {
+        return Err(SimplifyError::LockedVertexOutOfRange {
+            index,
+            vertex_count: mesh.vertex_count(),
+        });
+    }
+    let cleaned = clean(mesh, &options.clean);
+    // Locked input vertices, renumbered like the cleaned mesh (unreferenced ones drop).
+    let locked: Vec<u32> = options
+        .locked_vertices
+        .iter()
+        .map(|&i| cleaned.vertex_map[i as usize])
+        .filter(|&i| i != Cleaned::REMOVED)
+        .collect();
+    let cleanup = cleaned.report;
+    if cleaned.mesh.triangles.is_empty() {
+        return Err(SimplifyError::NothingLeftAfterCleaning {
+            triangles_in: mesh.triangle_count(),
+        });
+    }
+    timings.clean = clock.elapsed();
+
+    let clock = Instant::now();
+    let (store, keys) = MeshStore::from_mesh(&cleaned.mesh)?;
+    timings.build = clock.elapsed();
+
+    let frame = Frame::from_points(cleaned.mesh.positions.iter().map(|p| DVec3::from_array(*p)));
+    let mut engine = Engine::new(store, frame, options);
+    let clock = Instant::now();
+    engine.initialise(&cleaned.mesh, &keys, &locked, options);
+    timings.setup = clock.elapsed();
+    observer.cleaned(&cleaned.mesh, &frame);
+
+    let mut results = Vec::with_capacity(levels.len());
+    let mut stopped_short: Option<StopReason> = None;
+    for &level in levels {
+        let target_triangles = target_count(level, mesh.triangle_count());
+        let clock = Instant::now();
+        let stop_reason = match stopped_short {
+            Some(reason) => reason,
+            None => engine.run(target_triangles, options, observer)?,
+        };
+        if stop_reason != StopReason::TargetReached {
+            stopped_short = Some(stop_reason);
+        }
+        timings.contract += clock.elapsed();
+
+        let clock = Instant::now();
+        let raw = engine.store.to_mesh();
+        let final_clean = clean(&raw, &CleanOptions::OUTPUT);
+        let out = final_clean.mesh;
+        timings.compact = clock.elapsed();
+
+        let counters = engine.counters;
+        let report = SimplifyReport {
+            triangles_in: mesh.triangle_count(),
+            vertices_in: mesh.vertex_count(),
+            triangles_out: out.triangle_count(),
+            vertices_out: out.vertex_count(),
+            target_triangles,
+            edge_contractions: counters.edge_contractions,
+            virtual_contractions: counters.virtual_contractions,
+            virtual_pairs: counters.virtual_pairs,
+            virtual_pairs_capped: counters.virtual_pairs_capped,
+            max_error: frame.distance_to_diagonal_fraction(counters.max_error),
+            max_error_abs: frame.distance_to_world(counters.max_error),
+            bbox_diagonal: frame.world_diagonal(),
+            stop_reason,
+            cleanup,
+            degenerate_faces_removed: final_clean.report.zero_area_faces
+                + final_clean.report.repeated_index_faces,
+            rejected_degenerate: counters.rejected_degenerate,
+            rejected_flip: counters.rejected_flip,
+            rejected_sliver: counters.rejected_sliver,
+            rejected_topology: counters.rejected_topology,
+            rejected_locked: counters.rejected_locked,
+            rejected_border: counters.rejected_border,
+            locked_vertices: counters.locked_vertices,
+            faces_flipped: engine.flipped_faces(),
+            timings,
+        };
+        results.push(Simplified { mesh: out, report });
+    }
+    Ok(results)
+}
+
+/// The triangle count a target asks for, given the input's count as loaded.
+fn target_count(target: Target, triangles_in: usize) -> usize {
+    match target {
+        Target::Triangles(n) => n,
+        Target::Ratio(r) if r > 0.0 => (r.min(1.0) * triangles_in as f64).floor() as usize,
+        Target::Ratio(_) => 0,
+        Target::None => 0,
+    }
+}

@@ -1,0 +1,74 @@
+//! Watching a run: progress, cancellation, and (for tests and tools) each contraction.
+
+use crate::IndexedMesh;
+use qem_core::{DVec3, Frame, Quadric};
+
+/// Progress of the contraction loop, as given to an [`Observer`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Progress {
+    /// Triangles left now.
+    pub triangles: usize,
+    /// Triangles at the start of the loop.
+    pub triangles_start: usize,
+    /// The target.
+    pub target: usize,
+}
+
+impl Progress {
+    /// The fraction of the work done, between 0 and 1.
+    pub fn fraction(&self) -> f64 {
+        let total = self.triangles_start.saturating_sub(self.target);
+        if total == 0 {
+            return 1.0;
+        }
+        let done = self.triangles_start.saturating_sub(self.triangles);
+        (done as f64 / total as f64).min(1.0)
+    }
+}
+
+/// One contraction, as reported to [`Observer::contracted`].
+///
+/// Vertices are named by their index in the *cleaned* mesh given to
+/// [`Observer::cleaned`]; a vertex that has absorbed others keeps the index of the
+/// vertex that survived. Geometry is in the normalised [`Frame`] given there.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct Contraction {
+    /// The vertex that stays (and moves to `position`).
+    pub kept: u32,
+    /// The vertex that was merged into `kept` and no longer exists.
+    pub removed: u32,
+    /// Whether no edge joined them (a virtual pair).
+    pub is_virtual: bool,
+    /// The quadric of the merged vertex (normalised frame): `Q_kept + Q_removed`, or
+    /// their union with [`QuadricMode::Exact`](super::QuadricMode::Exact).
+    pub quadric: Quadric,
+    /// The new position, normalised frame.
+    pub position: DVec3,
+    /// `quadric` evaluated at the chosen position (clamped to be non-negative).
+    pub cost: f64,
+}
+
+/// Receives progress and may cancel a run. Every method has a no-op default.
+pub trait Observer {
+    /// Called every few thousand contractions, and once at the end.
+    fn progress(&mut self, _progress: Progress) {}
+    /// Polled with [`progress`](Self::progress); returning `true` stops the run with
+    /// [`StopReason::Cancelled`](super::StopReason::Cancelled) (the partial result is
+    /// still a valid mesh).
+    fn should_stop(&mut self) -> bool {
+        false
+    }
+    /// Called once before the loop with the cleaned mesh whose vertex indices
+    /// [`Contraction`] uses, and the frame its quadrics are computed in.
+    fn cleaned(&mut self, _mesh: &IndexedMesh, _frame: &Frame) {}
+    /// Called after every contraction. Meant for tests and analysis tools: it is on the
+    /// hot path, so keep it cheap.
+    fn contracted(&mut self, _contraction: &Contraction) {}
+}
+
+/// The observer that does nothing.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NoObserver;
+
+impl Observer for NoObserver {}

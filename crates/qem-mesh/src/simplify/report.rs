@@ -1,0 +1,189 @@
+//! What a run did ([`SimplifyReport`]), why it stopped, and why it could not run.
+
+use crate::clean::CleanReport;
+use crate::store::StoreError;
+use crate::{IndexedMesh, InputError};
+use std::fmt;
+use std::time::Duration;
+
+/// Why the loop stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StopReason {
+    /// The triangle count reached the target (or was already at or below it).
+    TargetReached,
+    /// The next contraction would have exceeded the error bound.
+    MaxErrorReached,
+    /// No candidate pair was left before the target.
+    NoValidPair,
+    /// The observer asked to stop.
+    Cancelled,
+}
+
+impl StopReason {
+    /// A short snake_case name, as used in JSON reports.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            StopReason::TargetReached => "target_reached",
+            StopReason::MaxErrorReached => "max_error_reached",
+            StopReason::NoValidPair => "no_valid_pair",
+            StopReason::Cancelled => "cancelled",
+        }
+    }
+}
+
+impl fmt::Display for StopReason {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// Wall time of each phase of a run.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Timings {
+    /// Validation and cleaning.
+    pub clean: Duration,
+    /// Building the store.
+    pub build: Duration,
+    /// Face and vertex quadrics, candidate pairs and the queue.
+    pub setup: Duration,
+    /// The contraction loop.
+    pub contract: Duration,
+    /// Compaction back to an [`IndexedMesh`].
+    pub compact: Duration,
+}
+
+/// What a simplification did.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct SimplifyReport {
+    /// Triangles in the input, as given.
+    pub triangles_in: usize,
+    /// Vertices in the input, as given.
+    pub vertices_in: usize,
+    /// Triangles in the output.
+    pub triangles_out: usize,
+    /// Vertices in the output.
+    pub vertices_out: usize,
+    /// The target the run aimed for, in triangles.
+    pub target_triangles: usize,
+    /// Contractions of pairs joined by an edge.
+    pub edge_contractions: usize,
+    /// Contractions of virtual pairs (no shared edge).
+    pub virtual_contractions: usize,
+    /// Virtual pairs found by the grid (after the per-vertex cap).
+    pub virtual_pairs: usize,
+    /// Virtual pairs the per-vertex cap left out.
+    pub virtual_pairs_capped: usize,
+    /// The largest contraction error, as a fraction of the input's bounding-box
+    /// diagonal.
+    ///
+    /// The error of a contraction is a distance: `sqrt(cost / weight)`, the square root
+    /// of the quadric cost at the new position divided by the quadric's total plane
+    /// weight (its total area, with area weighting) — the RMS distance of the new vertex
+    /// to the planes it has accumulated. So `0.001` means about 0.1% of the diagonal.
+    pub max_error: f64,
+    /// [`max_error`](Self::max_error) in model units.
+    pub max_error_abs: f64,
+    /// The input's bounding-box diagonal, in model units (after cleaning).
+    pub bbox_diagonal: f64,
+    /// Why the loop stopped.
+    pub stop_reason: StopReason,
+    /// What the cleaning passes removed or merged.
+    pub cleanup: CleanReport,
+    /// Faces of the result dropped at compaction because contraction left them with
+    /// zero area.
+    pub degenerate_faces_removed: usize,
+    /// Contractions refused because they would have left a surviving face with zero
+    /// area.
+    pub rejected_degenerate: usize,
+    /// Contractions refused because a surviving face's normal would have turned by more
+    /// than [`max_normal_angle`](super::SimplifyOptions::max_normal_angle).
+    pub rejected_flip: usize,
+    /// Contractions refused because a surviving face would have become a sliver (below
+    /// [`min_triangle_quality`](super::SimplifyOptions::min_triangle_quality)).
+    pub rejected_sliver: usize,
+    /// Contractions refused by [`preserve_topology`](super::SimplifyOptions::preserve_topology):
+    /// link condition failed, or a non-manifold vertex or edge.
+    pub rejected_topology: usize,
+    /// Contractions refused because both vertices were locked, or because a locked
+    /// vertex would have lost its last face.
+    pub rejected_locked: usize,
+    /// Contractions refused because they would have pinched, closed or removed a border
+    /// loop (with any [`BoundaryMode`](super::BoundaryMode) but `Free`).
+    pub rejected_border: usize,
+    /// Vertices of the cleaned input that were locked (by
+    /// [`locked_vertices`](super::SimplifyOptions::locked_vertices) or by
+    /// [`BoundaryMode::Locked`](super::BoundaryMode::Locked)).
+    pub locked_vertices: usize,
+    /// Output faces whose normal points more than 90° away from the normal of the input
+    /// face they descend from (each output face is a moved input face). The fold-over
+    /// check ([`max_normal_angle`](super::SimplifyOptions::max_normal_angle) below 180°)
+    /// refuses every contraction that would make one, so this is 0 unless the check is
+    /// off; it is a cheap self-check, not a comparison with the input surface.
+    pub faces_flipped: usize,
+    /// Wall time per phase.
+    pub timings: Timings,
+}
+
+/// Why a simplification could not run. Stopping short of the target is not an error
+/// (see [`StopReason`]).
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum SimplifyError {
+    /// The input failed validation.
+    Input(InputError),
+    /// Every triangle was degenerate or a duplicate: nothing is left to simplify.
+    NothingLeftAfterCleaning {
+        /// How many triangles the input had.
+        triangles_in: usize,
+    },
+    /// A locked vertex index is not a vertex of the input.
+    LockedVertexOutOfRange {
+        /// The offending index.
+        index: u32,
+        /// How many vertices the input has.
+        vertex_count: usize,
+    },
+    /// A bug: the store broke an invariant (only detected with
+    /// [`SimplifyOptions::validate_each_contraction`](super::SimplifyOptions::validate_each_contraction)).
+    Internal(StoreError),
+}
+
+impl fmt::Display for SimplifyError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            SimplifyError::Input(e) => e.fmt(f),
+            SimplifyError::NothingLeftAfterCleaning { triangles_in } => write!(
+                f,
+                "all {triangles_in} triangles are degenerate (repeated vertex or zero area): \
+                 nothing is left to simplify"
+            ),
+            SimplifyError::LockedVertexOutOfRange {
+                index,
+                vertex_count,
+            } => write!(
+                f,
+                "locked vertex {index} is out of range: the input has {vertex_count} \
+                 vertices (indices start at 0)"
+            ),
+            SimplifyError::Internal(e) => write!(f, "internal error, please report: {e}"),
+        }
+    }
+}
+
+impl std::error::Error for SimplifyError {}
+
+impl From<InputError> for SimplifyError {
+    fn from(e: InputError) -> Self {
+        SimplifyError::Input(e)
+    }
+}
+
+/// The result of a simplification.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Simplified {
+    /// The simplified mesh.
+    pub mesh: IndexedMesh,
+    /// What happened.
+    pub report: SimplifyReport,
+}
