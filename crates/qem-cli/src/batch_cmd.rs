@@ -70,7 +70,7 @@ pub struct BatchArgs {
     /// report].
     #[arg(long, value_name = "REPORT.json")]
     pub report: Option<PathBuf>,
-    /// No progress bar and no summary line (failures are still printed).
+    /// No progress bar and no summary line; failures are still printed [default: off].
     #[arg(short, long)]
     pub quiet: bool,
 }
@@ -258,7 +258,18 @@ fn plan(
         .iter()
         .zip(&outputs)
         .map(|(input, output)| {
+            let overwrites_input = output.as_deref().is_some_and(|o| {
+                o.canonicalize()
+                    .ok()
+                    .is_some_and(|c| input.path.canonicalize().ok() == Some(c))
+            });
             let refused = output.as_deref().and_then(|o| {
+                if overwrites_input {
+                    return Some(format!(
+                        "{}: its output would overwrite it; choose another --out-dir",
+                        input.path.display()
+                    ));
+                }
                 let others: Vec<String> = writers[o]
                     .iter()
                     .filter(|p| **p != input.path)

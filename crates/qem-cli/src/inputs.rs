@@ -44,7 +44,14 @@ pub fn expand(args: &[PathBuf], out_dir: &Path) -> Expanded {
     let out_canonical = out_dir.canonicalize().ok();
     let mut found = Expanded::default();
     for arg in args {
-        if arg.is_dir() {
+        if arg.is_dir() && arg.canonicalize().ok() == out_canonical {
+            found.failures.push((
+                arg.display().to_string(),
+                "is the output directory; its outputs would overwrite the inputs, \
+                 choose another --out-dir"
+                    .to_string(),
+            ));
+        } else if arg.is_dir() {
             let before = found.inputs.len();
             walk(arg, arg, out_canonical.as_deref(), &mut found);
             if found.inputs.len() == before {

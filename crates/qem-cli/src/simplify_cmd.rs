@@ -42,7 +42,7 @@ pub struct SimplifyArgs {
     /// [default: no report].
     #[arg(long, value_name = "REPORT.json")]
     pub report: Option<PathBuf>,
-    /// No progress bar and no summary line (errors are still printed).
+    /// No progress bar and no summary line; errors are still printed [default: off].
     #[arg(short, long)]
     pub quiet: bool,
 }

@@ -452,3 +452,24 @@ fn failed_files_leave_no_directories_and_empty_folders_fail() {
     );
     assert!(errors[1].contains("corrupt.ply: line 3"), "{errors:?}");
 }
+
+#[test]
+fn inputs_are_never_overwritten() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = dir.path().join("a.ply");
+    write_path(&a, &bumpy_grid(6, 0)).unwrap();
+    let before = std::fs::read(&a).unwrap();
+    // The folder as its own output directory, and the file into its own folder.
+    let o = qem(&["batch", s(dir.path()), "--out-dir", s(dir.path())]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("is the output directory"),
+        "{}",
+        stderr(&o)
+    );
+    let o = qem(&["batch", s(&a), "--out-dir", s(dir.path())]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("would overwrite it"), "{}", stderr(&o));
+    assert!(std::fs::read(&a).unwrap() == before);
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+}
