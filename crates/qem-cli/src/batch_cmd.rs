@@ -117,7 +117,7 @@ pub fn run(args: &BatchArgs) -> Result<(), Failure> {
         .build()
         .map_err(|e| Failure::Failed(format!("cannot start {jobs} worker threads: {e}")))?;
 
-    let options = args.flags.options();
+    let options = args.flags.options()?;
     let bar = batch_bar(bars_wanted(args.quiet), tasks.len());
     let failed_so_far = AtomicUsize::new(0);
     let clock = Instant::now();

@@ -2,10 +2,33 @@
 //! command that simplifies): one clap `Args` struct that each command flattens, so a
 //! new option is added in one place.
 
-use clap::Args;
-use qem_mesh::simplify::{Length, SimplifyOptions, Target};
+use crate::failure::Failure;
+use clap::{Args, ValueEnum};
+use qem_mesh::simplify::{
+    BoundaryMode, Length, QuadricMode, SimplifyOptions, Target, VirtualPairs,
+    DEFAULT_BOUNDARY_WEIGHT, DEFAULT_MAX_NORMAL_ANGLE, DEFAULT_MIN_TRIANGLE_QUALITY,
+};
+use std::path::{Path, PathBuf};
 
-/// How to simplify: target, error bound, virtual pairs.
+/// The quadric a contracted pair gets (`--quadrics`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum QuadricsFlag {
+    /// Garland–Heckbert's sum of the two quadrics (shared planes count twice).
+    Sum,
+    /// The quadric of the union of the two plane sets (every plane counts once).
+    Exact,
+}
+
+/// Which unconnected vertex pairs may merge (`--virtual-pairs`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum VirtualPairsFlag {
+    /// Any two close vertices that share no edge (also closes cracks inside a part).
+    Any,
+    /// Only vertices of different connected parts.
+    BetweenParts,
+}
+
+/// How to simplify: target, error bound, virtual pairs, quality controls.
 #[derive(Args, Debug, Clone)]
 pub struct SimplifyFlags {
     /// Target as a fraction of the input's triangles (as loaded), in (0, 1]
@@ -28,6 +51,43 @@ pub struct SimplifyFlags {
     /// bounding-box diagonal [default: off].
     #[arg(long)]
     pub absolute: bool,
+    /// Which close unconnected pairs may merge when --pair-threshold is above 0.
+    #[arg(long, value_enum, default_value_t = VirtualPairsFlag::Any)]
+    pub virtual_pairs: VirtualPairsFlag,
+    /// Weight of the constraint planes through border edges (perpendicular to the
+    /// border's face), relative to the faces' own planes; 0 lets borders move freely
+    /// (border loops are still never pinched or closed).
+    #[arg(long, default_value_t = DEFAULT_BOUNDARY_WEIGHT, value_parser = parse_non_negative,
+          conflicts_with = "lock_boundary")]
+    pub boundary_weight: f64,
+    /// Border vertices never move and are never removed: borders come out exactly as
+    /// they went in [default: off].
+    #[arg(long)]
+    pub lock_boundary: bool,
+    /// Refuse a contraction that turns a surviving face's normal by more than this many
+    /// degrees (or leaves it more than 90° from the input face it descends from); 180
+    /// turns the check off.
+    #[arg(long, default_value_t = DEFAULT_MAX_NORMAL_ANGLE, value_parser = parse_non_negative)]
+    pub max_normal_angle: f64,
+    /// Refuse a contraction that leaves a face with a quality (4√3·area / sum of
+    /// squared edge lengths: 1 equilateral, 0 degenerate) below this and below its
+    /// quality before; 0 turns the check off.
+    #[arg(long, default_value_t = DEFAULT_MIN_TRIANGLE_QUALITY, value_parser = parse_unit_interval)]
+    pub min_quality: f64,
+    /// Keep the topology: only contractions that pass the link condition, none at
+    /// non-manifold vertices or edges, no virtual pairs; Euler characteristic, parts and
+    /// border loops are kept [default: off].
+    #[arg(long)]
+    pub preserve_topology: bool,
+    /// Quadric of a contracted pair.
+    #[arg(long, value_enum, default_value_t = QuadricsFlag::Sum)]
+    pub quadrics: QuadricsFlag,
+    /// A text file of vertex indices that must come out unmoved and present: one per
+    /// line, 0-based, `#` starts a comment. Indices follow the vertex order as loaded:
+    /// the file's order for PLY and OFF, three per facet for STL, and for OBJ the order
+    /// in which faces first use them [default: none].
+    #[arg(long, value_name = "FILE")]
+    pub lock: Option<PathBuf>,
 }
 
 /// Parses a ratio in (0, 1].
@@ -54,6 +114,39 @@ fn parse_non_negative(s: &str) -> Result<f64, String> {
     }
 }
 
+fn parse_unit_interval(s: &str) -> Result<f64, String> {
+    let v = parse_non_negative(s)?;
+    if v <= 1.0 {
+        Ok(v)
+    } else {
+        Err(format!("{v} is outside [0, 1]"))
+    }
+}
+
+/// Reads a lock file: one vertex index per line; blank lines and `#` comments are
+/// skipped. Errors name the file and the line.
+pub fn read_lock_file(path: &Path) -> Result<Vec<u32>, String> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("{}: cannot read the lock file: {e}", path.display()))?;
+    let mut indices = Vec::new();
+    for (number, line) in text.lines().enumerate() {
+        let content = line.split('#').next().unwrap_or("").trim();
+        if content.is_empty() {
+            continue;
+        }
+        let index: u32 = content.parse().map_err(|_| {
+            format!(
+                "{}:{}: `{content}` is not a vertex index (a whole number from 0 to {})",
+                path.display(),
+                number + 1,
+                u32::MAX
+            )
+        })?;
+        indices.push(index);
+    }
+    Ok(indices)
+}
+
 impl SimplifyFlags {
     fn length(&self, v: f64) -> Length {
         if self.absolute {
@@ -63,17 +156,42 @@ impl SimplifyFlags {
         }
     }
 
-    /// The library options these flags ask for.
-    pub fn options(&self) -> SimplifyOptions {
+    /// The library options these flags ask for; fails (naming the file and line) when
+    /// the lock file cannot be read.
+    pub fn options(&self) -> Result<SimplifyOptions, Failure> {
         let target = match (self.triangles, self.ratio) {
             (Some(n), _) => Target::Triangles(n),
             (None, Some(r)) => Target::Ratio(r),
             (None, None) => Target::Ratio(0.5),
         };
-        SimplifyOptions::DEFAULT
+        let options = SimplifyOptions::DEFAULT
             .with_target(target)
             .with_max_error(self.max_error.map(|e| self.length(e)))
             .with_pair_threshold(self.length(self.pair_threshold))
+            .with_virtual_pairs(match self.virtual_pairs {
+                VirtualPairsFlag::Any => VirtualPairs::Any,
+                VirtualPairsFlag::BetweenParts => VirtualPairs::BetweenComponents,
+            })
+            .with_boundary(if self.lock_boundary {
+                BoundaryMode::Locked
+            } else if self.boundary_weight > 0.0 {
+                BoundaryMode::Planes(self.boundary_weight)
+            } else {
+                BoundaryMode::Free
+            })
+            .with_max_normal_angle(self.max_normal_angle)
+            .with_min_triangle_quality(self.min_quality)
+            .with_preserve_topology(self.preserve_topology)
+            .with_quadrics(match self.quadrics {
+                QuadricsFlag::Sum => QuadricMode::Sum,
+                QuadricsFlag::Exact => QuadricMode::Exact,
+            });
+        Ok(match &self.lock {
+            Some(path) => {
+                options.with_locked_vertices(read_lock_file(path).map_err(Failure::Failed)?)
+            }
+            None => options,
+        })
     }
 }
 

@@ -32,7 +32,14 @@ pub struct SimplifyJson {
     stop_reason: &'static str,
     cleanup: BTreeMap<&'static str, usize>,
     degenerate_faces_removed: usize,
-    rejected_degenerate: usize,
+    /// Contractions refused, by reason: `degenerate`, `flip`, `sliver`, `topology`,
+    /// `locked`, `border`, `merge`.
+    rejected: BTreeMap<&'static str, usize>,
+    /// Vertices locked (by --lock or --lock-boundary).
+    locked_vertices: usize,
+    /// Output faces whose normal points away from their input face (0 unless the
+    /// fold-over check is off).
+    faces_flipped: usize,
     timings_ms: BTreeMap<&'static str, f64>,
 }
 
@@ -88,7 +95,17 @@ impl SimplifyJson {
             stop_reason: r.stop_reason.as_str(),
             cleanup,
             degenerate_faces_removed: r.degenerate_faces_removed,
-            rejected_degenerate: r.rejected_degenerate,
+            rejected: BTreeMap::from([
+                ("degenerate", r.rejected_degenerate),
+                ("flip", r.rejected_flip),
+                ("sliver", r.rejected_sliver),
+                ("topology", r.rejected_topology),
+                ("locked", r.rejected_locked),
+                ("border", r.rejected_border),
+                ("merge", r.rejected_merge),
+            ]),
+            locked_vertices: r.locked_vertices,
+            faces_flipped: r.faces_flipped,
             timings_ms,
         }
     }

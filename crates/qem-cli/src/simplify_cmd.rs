@@ -69,7 +69,7 @@ fn run_single(args: &SimplifyArgs) -> Result<(), Failure> {
     let result = simplify_file(
         &args.input,
         &args.output,
-        &args.flags.options(),
+        &args.flags.options()?,
         &mut BarObserver::new(&bar),
         false,
     );
@@ -169,7 +169,7 @@ fn run_levels(args: &SimplifyArgs) -> Result<(), Failure> {
         let clock = Instant::now();
         let levels = simplify_levels(
             &mesh,
-            &args.flags.options(),
+            &args.flags.options()?,
             &targets,
             &mut BarObserver::new(&bar),
         )

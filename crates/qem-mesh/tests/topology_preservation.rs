@@ -150,4 +150,32 @@ mod corpus {
             assert_topology_kept(name, &mesh, &preserving(0.1));
         }
     }
+
+    /// Regression: with the *default* options (no topology mode), closed scans used to
+    /// come out with holes — c3d_nefertiti had 9 border loops after a 50% run — because
+    /// an edge contraction merged a face `a x y` with a face `b x y`. That merge is now
+    /// refused, so closed inputs stay closed.
+    #[test]
+    fn closed_corpus_meshes_stay_closed_with_default_options() {
+        let Some(dir) = corpus_dir() else { return };
+        for name in ["c3d_nefertiti.obj", "npm_bunny.obj", "igl_fertility.obj"] {
+            let Some(path) = [dir.join(name), dir.join("public").join(name)]
+                .into_iter()
+                .find(|p| p.is_file())
+            else {
+                eprintln!("SKIPPED: {name} is not in {}", dir.display());
+                continue;
+            };
+            let mesh = qem_mesh::io::read_path(&path)
+                .unwrap_or_else(|e| panic!("{name}: {e}"))
+                .mesh;
+            assert_eq!(topology(&mesh).2, 0, "{name} is closed");
+            for ratio in [0.5, 0.1] {
+                let options = SimplifyOptions::DEFAULT.with_target(Target::Ratio(ratio));
+                let out = simplify(&mesh, &options).unwrap_or_else(|e| panic!("{name}: {e}"));
+                let (_, _, loops) = topology(&out.mesh);
+                assert_eq!(loops, 0, "{name} at {ratio}: {loops} holes opened");
+            }
+        }
+    }
 }

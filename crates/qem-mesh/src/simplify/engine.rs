@@ -63,6 +63,7 @@ pub(super) struct Counters {
     pub rejected_topology: usize,
     pub rejected_locked: usize,
     pub rejected_border: usize,
+    pub rejected_merge: usize,
     pub locked_vertices: usize,
 }
 
@@ -75,6 +76,7 @@ impl Counters {
             Rejection::Topology => &mut self.rejected_topology,
             Rejection::Locked => &mut self.rejected_locked,
             Rejection::Border => &mut self.rejected_border,
+            Rejection::Merge => &mut self.rejected_merge,
         };
         *counter += 1;
     }

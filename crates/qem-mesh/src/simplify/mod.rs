@@ -201,6 +201,7 @@ pub fn simplify_levels(
             rejected_topology: counters.rejected_topology,
             rejected_locked: counters.rejected_locked,
             rejected_border: counters.rejected_border,
+            rejected_merge: counters.rejected_merge,
             locked_vertices: counters.locked_vertices,
             faces_flipped: engine.flipped_faces(),
             timings,

@@ -111,6 +111,10 @@ pub struct SimplifyReport {
     /// Contractions refused because they would have pinched, closed or removed a border
     /// loop (with any [`BoundaryMode`](super::BoundaryMode) but `Free`).
     pub rejected_border: usize,
+    /// Edge contractions refused because two faces `a x y` and `b x y` would have merged
+    /// into one, which opens a hole in a closed surface (virtual pairs may merge faces:
+    /// joining parts is their purpose).
+    pub rejected_merge: usize,
     /// Vertices of the cleaned input that were locked (by
     /// [`locked_vertices`](super::SimplifyOptions::locked_vertices) or by
     /// [`BoundaryMode::Locked`](super::BoundaryMode::Locked)).

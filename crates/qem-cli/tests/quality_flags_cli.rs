@@ -1,0 +1,188 @@
+//! The quality-control flags of `qem simplify` (shared with `qem batch`): locks,
+//! borders, topology, quadrics, and how they show in the report.
+
+use qem_mesh::inspect::inspect;
+use qem_mesh::io::read_path;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn qem(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_qem"))
+        .args(args)
+        .output()
+        .expect("qem runs")
+}
+
+fn spot() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/spot.obj")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn path_str(p: &Path) -> &str {
+    p.to_str().expect("temp paths are UTF-8")
+}
+
+/// Locked vertices come out bit for bit where they were (the PLY output keeps doubles).
+#[test]
+fn locked_vertices_are_in_the_output_unmoved() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let lock = dir.path().join("lock.txt");
+    let locked: Vec<usize> = (0..40).map(|i| i * 37).collect();
+    let mut text = String::from("# every 37th vertex\n\n");
+    for i in &locked {
+        text.push_str(&format!("{i}  # a comment after the index\n"));
+    }
+    std::fs::write(&lock, text).expect("write lock file");
+    let out = dir.path().join("out.ply");
+    let report = dir.path().join("report.json");
+    let o = qem(&[
+        "simplify",
+        path_str(&spot()),
+        "-o",
+        path_str(&out),
+        "--ratio",
+        "0.05",
+        "--lock",
+        path_str(&lock),
+        "--report",
+        path_str(&report),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+
+    let input = read_path(&spot()).expect("spot loads").mesh;
+    let output = read_path(&out).expect("output loads").mesh;
+    for &i in &locked {
+        let p = input.positions[i];
+        assert!(
+            output.positions.iter().any(|q| q == &p),
+            "locked vertex {i} at {p:?} is not in the output"
+        );
+    }
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("json");
+    assert_eq!(json["locked_vertices"], locked.len());
+    for reason in [
+        "degenerate",
+        "flip",
+        "sliver",
+        "topology",
+        "locked",
+        "border",
+        "merge",
+    ] {
+        assert!(json["rejected"].get(reason).is_some(), "{json}");
+    }
+}
+
+#[test]
+fn a_bad_lock_file_names_the_file_and_line() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let lock = dir.path().join("lock.txt");
+    std::fs::write(&lock, "3\nseven\n").expect("write lock file");
+    let out = dir.path().join("out.obj");
+    let o = qem(&[
+        "simplify",
+        path_str(&spot()),
+        "-o",
+        path_str(&out),
+        "--lock",
+        path_str(&lock),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = stderr(&o);
+    assert!(err.contains("lock.txt:2:"), "{err}");
+    assert!(err.contains("`seven` is not a vertex index"), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(!out.exists());
+}
+
+#[test]
+fn a_lock_index_past_the_end_is_an_error() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let lock = dir.path().join("lock.txt");
+    std::fs::write(&lock, "999999\n").expect("write lock file");
+    let out = dir.path().join("out.obj");
+    let o = qem(&[
+        "simplify",
+        path_str(&spot()),
+        "-o",
+        path_str(&out),
+        "--lock",
+        path_str(&lock),
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("999999"), "{}", stderr(&o));
+    assert!(!out.exists());
+}
+
+/// The cow is a closed genus-0 surface: with --preserve-topology it stays one closed
+/// 2-manifold part with Euler characteristic 2 (V − E + F with E = 3F/2).
+#[test]
+fn preserve_topology_keeps_the_cow_a_sphere() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("out.ply");
+    for quadrics in ["sum", "exact"] {
+        let o = qem(&[
+            "simplify",
+            path_str(&spot()),
+            "-o",
+            path_str(&out),
+            "--ratio",
+            "0.02",
+            "--preserve-topology",
+            "--quadrics",
+            quadrics,
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let mesh = read_path(&out).expect("output loads").mesh;
+        let info = inspect(&mesh).expect("valid output");
+        assert_eq!(info.components, 1);
+        assert_eq!(info.boundary_edges, 0);
+        assert_eq!(info.nonmanifold_edges, 0);
+        assert_eq!(info.nonmanifold_vertices, 0);
+        assert_eq!(
+            2 * info.vertices as i64 - info.triangles as i64,
+            4,
+            "Euler characteristic changed: {info:?}"
+        );
+    }
+}
+
+#[test]
+fn lock_boundary_and_a_boundary_weight_conflict() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("out.obj");
+    let o = qem(&[
+        "simplify",
+        path_str(&spot()),
+        "-o",
+        path_str(&out),
+        "--lock-boundary",
+        "--boundary-weight",
+        "2",
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}
+
+#[test]
+fn help_lists_the_quality_flags_with_defaults() {
+    let o = qem(&["simplify", "--help"]);
+    assert!(o.status.success());
+    let help = String::from_utf8_lossy(&o.stdout);
+    for flag in [
+        "--boundary-weight",
+        "--lock-boundary",
+        "--max-normal-angle",
+        "--min-quality",
+        "--preserve-topology",
+        "--quadrics",
+        "--lock <FILE>",
+        "--virtual-pairs",
+    ] {
+        assert!(help.contains(flag), "--help lacks {flag}");
+    }
+    assert!(help.contains("[default: 90]"), "{help}");
+}
