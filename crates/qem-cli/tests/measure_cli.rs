@@ -1,26 +1,9 @@
 //! Runs the built `qem measure` as a user would.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn qem(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_qem"))
-        .args(args)
-        .output()
-        .expect("qem runs")
-}
-
-fn spot() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/spot.obj")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
+use common::{qem, spot, stderr, stdout};
+use std::path::Path;
 
 /// Few samples keep the test quick; the figures stay meaningful at this size.
 const FEW: [&str; 4] = ["--samples-per-face", "2", "--min-samples", "20000"];

@@ -1,29 +1,11 @@
 //! The quality-control flags of `qem simplify` (shared with `qem batch`): locks,
 //! borders, topology, quadrics, and how they show in the report.
 
+mod common;
+
+use common::{qem, s, spot, stderr};
 use qem_mesh::inspect::inspect;
 use qem_mesh::io::read_path;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn qem(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_qem"))
-        .args(args)
-        .output()
-        .expect("qem runs")
-}
-
-fn spot() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/spot.obj")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn path_str(p: &Path) -> &str {
-    p.to_str().expect("temp paths are UTF-8")
-}
 
 /// Locked vertices come out bit for bit where they were (the PLY output keeps doubles).
 #[test]
@@ -40,15 +22,15 @@ fn locked_vertices_are_in_the_output_unmoved() {
     let report = dir.path().join("report.json");
     let o = qem(&[
         "simplify",
-        path_str(&spot()),
+        s(&spot()),
         "-o",
-        path_str(&out),
+        s(&out),
         "--ratio",
         "0.05",
         "--lock",
-        path_str(&lock),
+        s(&lock),
         "--report",
-        path_str(&report),
+        s(&report),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
 
@@ -83,14 +65,7 @@ fn a_bad_lock_file_names_the_file_and_line() {
     let lock = dir.path().join("lock.txt");
     std::fs::write(&lock, "3\nseven\n").expect("write lock file");
     let out = dir.path().join("out.obj");
-    let o = qem(&[
-        "simplify",
-        path_str(&spot()),
-        "-o",
-        path_str(&out),
-        "--lock",
-        path_str(&lock),
-    ]);
+    let o = qem(&["simplify", s(&spot()), "-o", s(&out), "--lock", s(&lock)]);
     assert_eq!(o.status.code(), Some(1));
     let err = stderr(&o);
     assert!(err.contains("lock.txt:2:"), "{err}");
@@ -105,14 +80,7 @@ fn a_lock_index_past_the_end_is_an_error() {
     let lock = dir.path().join("lock.txt");
     std::fs::write(&lock, "999999\n").expect("write lock file");
     let out = dir.path().join("out.obj");
-    let o = qem(&[
-        "simplify",
-        path_str(&spot()),
-        "-o",
-        path_str(&out),
-        "--lock",
-        path_str(&lock),
-    ]);
+    let o = qem(&["simplify", s(&spot()), "-o", s(&out), "--lock", s(&lock)]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(stderr(&o).contains("999999"), "{}", stderr(&o));
     assert!(!out.exists());
@@ -127,9 +95,9 @@ fn preserve_topology_keeps_the_cow_a_sphere() {
     for quadrics in ["sum", "exact"] {
         let o = qem(&[
             "simplify",
-            path_str(&spot()),
+            s(&spot()),
             "-o",
-            path_str(&out),
+            s(&out),
             "--ratio",
             "0.02",
             "--preserve-topology",
@@ -157,9 +125,9 @@ fn lock_boundary_and_a_boundary_weight_conflict() {
     let out = dir.path().join("out.obj");
     let o = qem(&[
         "simplify",
-        path_str(&spot()),
+        s(&spot()),
         "-o",
-        path_str(&out),
+        s(&out),
         "--lock-boundary",
         "--boundary-weight",
         "2",

@@ -2,23 +2,8 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn qem(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_qem"))
-        .args(args)
-        .output()
-        .expect("qem runs")
-}
-
-fn spot() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/spot.obj")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+use common::{qem, spot, stderr};
+use std::process::Command;
 
 #[test]
 fn simplify_writes_mesh_and_report() {
