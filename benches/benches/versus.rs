@@ -32,11 +32,13 @@
 //! for peak-memory runs under `/usr/bin/time -v` on the bench binary
 //! (`cargo bench -p qem-bench --bench versus --no-run` prints its path): the tool's
 //! peak is the difference between its run and the `none` run. qem uses rayon's global
-//! pool; `RAYON_NUM_THREADS=1` makes it single-threaded.
+//! pool; `RAYON_NUM_THREADS=1` makes it single-threaded. `--tool prep` times qem's
+//! cleaning of the raw (unwelded) input and the building of its store from the cleaned
+//! mesh, the two phases before the quadrics, apart.
 
 use qem_mesh::clean::{clean, CleanOptions};
 use qem_mesh::simplify::{simplify, SimplifyOptions, Target};
-use qem_mesh::IndexedMesh;
+use qem_mesh::{IndexedMesh, MeshStore};
 use std::collections::HashMap;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -50,6 +52,8 @@ enum Tools {
     Meshopt,
     /// Load and weld only: the memory baseline.
     None,
+    /// qem's cleaning (of the raw input) and store building alone, timed apart.
+    Prep,
 }
 
 impl Tools {
@@ -71,7 +75,7 @@ struct Args {
 }
 
 const USAGE: &str = "usage: versus [--input dragon|soup|sphere:N|PATH]... [--ratios R,R...] \
-                     [--runs K] [--tool both|qem|meshopt|none]";
+                     [--runs K] [--tool both|qem|meshopt|none|prep]";
 
 fn parse_args() -> Result<Args, String> {
     let mut args = Args {
@@ -109,6 +113,7 @@ fn parse_args() -> Result<Args, String> {
                     "qem" => Tools::Qem,
                     "meshopt" => Tools::Meshopt,
                     "none" => Tools::None,
+                    "prep" => Tools::Prep,
                     other => return Err(format!("unknown tool {other:?}\n{USAGE}")),
                 }
             }
@@ -295,6 +300,26 @@ fn run_meshopt(
     })
 }
 
+/// Times `clean` on the raw input and `MeshStore::from_mesh` on its result.
+fn time_prep(input: &str, raw: &IndexedMesh, runs: usize) -> Result<(), String> {
+    let (mut clean_s, mut build_s) = (Vec::new(), Vec::new());
+    for _ in 0..runs {
+        let clock = Instant::now();
+        let cleaned = clean(raw, &CleanOptions::DEFAULT);
+        clean_s.push(clock.elapsed().as_secs_f64());
+        let clock = Instant::now();
+        let store = MeshStore::from_mesh(&cleaned.mesh).map_err(|e| e.to_string())?;
+        build_s.push(clock.elapsed().as_secs_f64());
+        std::hint::black_box((cleaned, store));
+    }
+    println!(
+        "{input}: clean {:.3} s, build {:.3} s (medians of {runs})",
+        median(&mut clean_s),
+        median(&mut build_s)
+    );
+    Ok(())
+}
+
 fn run() -> Result<(), String> {
     let args = parse_args()?;
     let threads = std::env::var("RAYON_NUM_THREADS").unwrap_or_else(|_| "default".into());
@@ -308,6 +333,10 @@ fn run() -> Result<(), String> {
     for input in &args.inputs {
         let clock = Instant::now();
         let Some(raw) = load(input)? else { continue };
+        if args.tools == Tools::Prep {
+            time_prep(input, &raw, args.runs)?;
+            continue;
+        }
         let welded = clean(&raw, &CleanOptions::DEFAULT).mesh;
         drop(raw);
         let positions: Vec<f32> = welded
