@@ -14,6 +14,11 @@
 //!   a target error of `f32::MAX`, so that it stops on the count alone. Only the call is
 //!   timed; its output indexes the input vertex buffer (no compaction).
 //!
+//! Wall time and CPU time (all threads, from `/proc`, Linux) are both reported: on a
+//! loaded machine the CPU-time ratio is the steadier one. meshopt's C++ is built
+//! without asserts (`NDEBUG`, see the meshopt profile override in the root
+//! `Cargo.toml`), as it ships.
+//!
 //! Usage (arguments after `--`; every flag optional):
 //!
 //! ```text
@@ -247,25 +252,73 @@ fn median(times: &mut [f64]) -> f64 {
     }
 }
 
-/// Median seconds and output triangle count of one tool.
+/// Median seconds (wall and CPU) and output triangle count of one tool.
 struct Measured {
     seconds: f64,
+    /// CPU time of the process (all threads), when the platform tells it.
+    cpu_seconds: Option<f64>,
     triangles_out: usize,
+}
+
+/// CPU time consumed so far by all threads of this process, in seconds, from
+/// `/proc/self/task/*/schedstat` (nanoseconds on the CPU; Linux only).
+///
+/// Why CPU time next to wall time: on a shared machine the wall time of a
+/// single-threaded run grows with the load while its CPU time barely does, so the
+/// CPU-time ratio of two tools stays meaningful when the wall-time ratio is noisy.
+fn process_cpu_seconds() -> Option<f64> {
+    let mut total_ns = 0u64;
+    for task in std::fs::read_dir("/proc/self/task").ok()? {
+        let stat = std::fs::read_to_string(task.ok()?.path().join("schedstat")).ok()?;
+        total_ns += stat.split_whitespace().next()?.parse::<u64>().ok()?;
+    }
+    Some(total_ns as f64 * 1e-9)
+}
+
+/// Times `f` in wall and CPU seconds.
+fn timed<T>(f: impl FnOnce() -> T) -> (T, f64, Option<f64>) {
+    let cpu = process_cpu_seconds();
+    let clock = Instant::now();
+    let out = f();
+    let wall = clock.elapsed().as_secs_f64();
+    let cpu = process_cpu_seconds()
+        .zip(cpu)
+        .map(|(after, before)| after - before);
+    (out, wall, cpu)
+}
+
+/// Median wall and CPU seconds of a list of runs.
+fn medians(wall: &mut [f64], cpu: &mut [Option<f64>]) -> (f64, Option<f64>) {
+    let mut cpu: Option<Vec<f64>> = cpu.iter().copied().collect();
+    (median(wall), cpu.as_deref_mut().map(median))
 }
 
 fn run_qem(mesh: &IndexedMesh, target: usize, runs: usize) -> Result<Measured, String> {
     let options = SimplifyOptions::DEFAULT.with_target(Target::Triangles(target));
-    let mut times = Vec::with_capacity(runs);
+    let (mut times, mut cpu_times) = (Vec::with_capacity(runs), Vec::with_capacity(runs));
     let mut triangles_out = 0;
-    for _ in 0..runs {
-        let clock = Instant::now();
-        let out = simplify(mesh, &options).map_err(|e| format!("qem: {e}"))?;
-        times.push(clock.elapsed().as_secs_f64());
+    for run in 0..runs {
+        let (out, wall, cpu) = timed(|| simplify(mesh, &options));
+        let out = out.map_err(|e| format!("qem: {e}"))?;
+        times.push(wall);
+        cpu_times.push(cpu);
         triangles_out = out.mesh.triangle_count();
+        let t = out.report.timings;
+        eprintln!(
+            "  qem run {run}: clean {:.3} s, build {:.3} s, setup {:.3} s, contract {:.3} s, \
+             compact {:.3} s",
+            t.clean.as_secs_f64(),
+            t.build.as_secs_f64(),
+            t.setup.as_secs_f64(),
+            t.contract.as_secs_f64(),
+            t.compact.as_secs_f64()
+        );
         std::hint::black_box(out);
     }
+    let (seconds, cpu_seconds) = medians(&mut times, &mut cpu_times);
     Ok(Measured {
-        seconds: median(&mut times),
+        seconds,
+        cpu_seconds,
         triangles_out,
     })
 }
@@ -278,24 +331,28 @@ fn run_meshopt(
 ) -> Result<Measured, String> {
     let bytes = meshopt::typed_to_bytes(positions);
     let adapter = meshopt::VertexDataAdapter::new(bytes, 12, 0).map_err(|e| e.to_string())?;
-    let mut times = Vec::with_capacity(runs);
+    let (mut times, mut cpu_times) = (Vec::with_capacity(runs), Vec::with_capacity(runs));
     let mut triangles_out = 0;
     for _ in 0..runs {
-        let clock = Instant::now();
-        let out = meshopt::simplify(
-            indices,
-            &adapter,
-            target * 3,
-            f32::MAX,
-            meshopt::SimplifyOptions::None,
-            None,
-        );
-        times.push(clock.elapsed().as_secs_f64());
+        let (out, wall, cpu) = timed(|| {
+            meshopt::simplify(
+                indices,
+                &adapter,
+                target * 3,
+                f32::MAX,
+                meshopt::SimplifyOptions::None,
+                None,
+            )
+        });
+        times.push(wall);
+        cpu_times.push(cpu);
         triangles_out = out.len() / 3;
         std::hint::black_box(out);
     }
+    let (seconds, cpu_seconds) = medians(&mut times, &mut cpu_times);
     Ok(Measured {
-        seconds: median(&mut times),
+        seconds,
+        cpu_seconds,
         triangles_out,
     })
 }
@@ -328,8 +385,11 @@ fn run() -> Result<(), String> {
         args.runs
     );
     println!();
-    println!("| input | tris in (welded) | ratio | target | tool | median s | M input tris/s | tris out | qem/meshopt |");
-    println!("|---|---|---|---|---|---|---|---|---|");
+    println!(
+        "| input | tris in (welded) | ratio | target | tool | median s | M input tris/s \
+         | tris out | qem/meshopt | median CPU s | qem/meshopt (CPU) |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
     for input in &args.inputs {
         let clock = Instant::now();
         let Some(raw) = load(input)? else { continue };
@@ -365,12 +425,19 @@ fn run() -> Result<(), String> {
             };
             for (tool, m) in [("qem", &qem), ("meshopt", &meshopt)] {
                 let Some(m) = m else { continue };
-                let versus = match (tool, &meshopt) {
-                    ("qem", Some(o)) => format!("{:.2}", m.seconds / o.seconds),
-                    _ => String::new(),
+                let (versus, versus_cpu) = match (tool, &meshopt) {
+                    ("qem", Some(o)) => (
+                        format!("{:.2}", m.seconds / o.seconds),
+                        m.cpu_seconds
+                            .zip(o.cpu_seconds)
+                            .map_or(String::new(), |(q, o)| format!("{:.2}", q / o)),
+                    ),
+                    _ => (String::new(), String::new()),
                 };
+                let cpu = m.cpu_seconds.map_or(String::new(), |c| format!("{c:.3}"));
                 println!(
-                    "| {input} | {n} | {ratio} | {target} | {tool} | {:.3} | {:.2} | {} | {versus} |",
+                    "| {input} | {n} | {ratio} | {target} | {tool} | {:.3} | {:.2} | {} | {versus} \
+                     | {cpu} | {versus_cpu} |",
                     m.seconds,
                     n as f64 / m.seconds / 1e6,
                     m.triangles_out,
