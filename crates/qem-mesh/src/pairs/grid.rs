@@ -98,7 +98,7 @@ pub fn virtual_pairs(
     // both ends — twice the distance tests of a one-sided scan — but every point is
     // independent, so the points are shared among threads and the lists do not depend
     // on how. `total` counts each allowed close pair once, from its lower index.
-    let per_point: Vec<(u32, Vec<(f64, u32)>, usize)> = sorted
+    let per_point: Vec<_> = sorted
         .par_iter()
         .map(|&(cell, i)| {
             let p = points[i as usize];
