@@ -15,10 +15,13 @@
 //! 6. drop unreferenced vertices.
 //!
 //! Everything is deterministic: vertices keep the order of their first occurrence and
-//! faces keep their order.
+//! faces keep their order. The exact weld, the per-face tests and the duplicate search
+//! run on rayon's thread pool; each is a map over independent items or a sort of
+//! distinct keys, so the result is the same for any number of threads.
 
 use crate::pairs::grid::{neighbour_cells, squared_distance};
 use qem_core::{DVec3, Frame};
+use rayon::prelude::*;
 use std::collections::HashMap;
 
 /// A face is zero-area when its area is at most this fraction of the squared
@@ -186,32 +189,32 @@ pub fn clean(mesh: &IndexedMesh, options: &CleanOptions) -> Cleaned {
 
     let frame = Frame::from_points(mesh.positions.iter().map(|p| DVec3::from_array(*p)));
     let min_double_area = min_double_area(frame.normalized_diagonal());
+    // Each face's fate is decided independently (in parallel), then the faces are
+    // kept and counted in input order, so the result does not depend on the threads.
+    let fates: Vec<FaceFate> = mesh
+        .triangles
+        .par_iter()
+        .map(|t| {
+            face_fate(
+                t,
+                &mesh.positions,
+                &representative,
+                &frame,
+                min_double_area,
+                options,
+            )
+        })
+        .collect();
     let mut faces: Vec<[u32; 3]> = Vec::with_capacity(mesh.triangles.len());
-    for t in &mesh.triangles {
-        if t.iter().any(|&i| i as usize >= n) {
-            report.repeated_index_faces += 1;
-            continue;
+    for fate in fates {
+        match fate {
+            FaceFate::Keep(f) => faces.push(f),
+            FaceFate::RepeatedIndex => report.repeated_index_faces += 1,
+            FaceFate::ZeroArea => report.zero_area_faces += 1,
         }
-        let f = t.map(|i| representative[i as usize]);
-        if f[0] == f[1] || f[1] == f[2] || f[0] == f[2] {
-            if options.drop_repeated_index {
-                report.repeated_index_faces += 1;
-                continue;
-            }
-        } else if options.drop_zero_area {
-            let [a, b, c] =
-                f.map(|i| frame.to_normalized(DVec3::from_array(mesh.positions[i as usize])));
-            let double_area = (b - a).cross(c - a).length();
-            // `!(x > min)` also drops NaN areas, which only overflow could produce.
-            if double_area.is_nan() || double_area <= min_double_area {
-                report.zero_area_faces += 1;
-                continue;
-            }
-        }
-        faces.push(f);
     }
     if options.drop_duplicates {
-        report.duplicate_faces = drop_duplicate_faces(&mut faces);
+        report.duplicate_faces = drop_duplicate_faces(&mut faces, n);
     }
 
     // Number the surviving vertices in input order.
@@ -239,7 +242,7 @@ pub fn clean(mesh: &IndexedMesh, options: &CleanOptions) -> Cleaned {
         vertex_map[i] = vertex_map[representative[i] as usize];
     }
     let triangles = faces
-        .iter()
+        .par_iter()
         .map(|f| f.map(|i| vertex_map[i as usize]))
         .collect();
     Cleaned {
@@ -247,6 +250,44 @@ pub fn clean(mesh: &IndexedMesh, options: &CleanOptions) -> Cleaned {
         report,
         vertex_map,
     }
+}
+
+/// What happens to one input face.
+enum FaceFate {
+    /// Kept, with its indices mapped to their representatives.
+    Keep([u32; 3]),
+    /// Dropped: an index out of range, or (with `drop_repeated_index`) a vertex twice.
+    RepeatedIndex,
+    /// Dropped: (numerically) zero area.
+    ZeroArea,
+}
+
+/// The fate of face `t` under `options`, given the welding in `representative`.
+fn face_fate(
+    t: &[u32; 3],
+    positions: &[[f64; 3]],
+    representative: &[u32],
+    frame: &Frame,
+    min_double_area: f64,
+    options: &CleanOptions,
+) -> FaceFate {
+    if t.iter().any(|&i| i as usize >= positions.len()) {
+        return FaceFate::RepeatedIndex;
+    }
+    let f = t.map(|i| representative[i as usize]);
+    if f[0] == f[1] || f[1] == f[2] || f[0] == f[2] {
+        if options.drop_repeated_index {
+            return FaceFate::RepeatedIndex;
+        }
+    } else if options.drop_zero_area {
+        let [a, b, c] = f.map(|i| frame.to_normalized(DVec3::from_array(positions[i as usize])));
+        let double_area = (b - a).cross(c - a).length();
+        // `!(x > min)` also drops NaN areas, which only overflow could produce.
+        if double_area.is_nan() || double_area <= min_double_area {
+            return FaceFate::ZeroArea;
+        }
+    }
+    FaceFate::Keep(f)
 }
 
 /// The bit pattern of a coordinate, with `-0.0` read as `+0.0`.
@@ -261,20 +302,20 @@ fn coordinate_bits(c: f64) -> u64 {
 /// Points each vertex at the first vertex with a bit-identical position; returns how
 /// many were merged.
 fn weld_exact(positions: &[[f64; 3]], representative: &mut [u32]) -> usize {
-    let key = |i: u32| positions[i as usize].map(coordinate_bits);
-    let mut order: Vec<u32> = (0..positions.len() as u32).collect();
-    // Stable, so within a group the lowest index comes first.
-    order.sort_by_key(|&i| key(i));
+    // (key, index) pairs are all distinct, so the unstable parallel sort has one
+    // possible result, and within a group the lowest index comes first.
+    let mut order: Vec<([u64; 3], u32)> = positions
+        .par_iter()
+        .enumerate()
+        .map(|(i, p)| (p.map(coordinate_bits), i as u32))
+        .collect();
+    order.par_sort_unstable();
     let mut merged = 0;
-    let mut group_start = 0;
-    for k in 1..=order.len() {
-        if k == order.len() || key(order[k]) != key(order[group_start]) {
-            let first = order[group_start];
-            for &i in &order[group_start + 1..k] {
-                representative[i as usize] = first;
-                merged += 1;
-            }
-            group_start = k;
+    for group in order.chunk_by(|x, y| x.0 == y.0) {
+        let first = group[0].1;
+        for &(_, i) in &group[1..] {
+            representative[i as usize] = first;
+            merged += 1;
         }
     }
     merged
@@ -316,19 +357,19 @@ fn weld_within(positions: &[[f64; 3]], tolerance: f64, representative: &mut [u32
 }
 
 /// Removes faces whose vertex set equals an earlier face's; returns how many.
-fn drop_duplicate_faces(faces: &mut Vec<[u32; 3]>) -> usize {
-    let sorted = |f: &[u32; 3]| {
-        let mut s = *f;
-        s.sort_unstable();
-        s
-    };
-    let mut order: Vec<u32> = (0..faces.len() as u32).collect();
-    order.sort_by_key(|&i| (sorted(&faces[i as usize]), i));
-    let mut keep = vec![true; faces.len()];
-    for w in order.windows(2) {
-        if sorted(&faces[w[0] as usize]) == sorted(&faces[w[1] as usize]) {
-            keep[w[1] as usize] = false;
-        }
+fn drop_duplicate_faces(faces: &mut Vec<[u32; 3]>, vertex_count: usize) -> usize {
+    let sets: Vec<([u32; 3], u32)> = faces
+        .par_iter()
+        .enumerate()
+        .map(|(i, f)| {
+            let mut set = *f;
+            set.sort_unstable();
+            (set, i as u32)
+        })
+        .collect();
+    let mut keep = vec![false; faces.len()];
+    for group in group_equal_sets(sets, vertex_count).chunk_by(|x, y| x.0 == y.0) {
+        keep[group[0].1 as usize] = true;
     }
     let before = faces.len();
     let mut k = 0;
@@ -337,6 +378,36 @@ fn drop_duplicate_faces(faces: &mut Vec<[u32; 3]>) -> usize {
         keep[k - 1]
     });
     before - faces.len()
+}
+
+/// Puts equal vertex sets next to each other, each group in the order of `sets`.
+///
+/// `sets` holds (sorted vertex set, face index) in increasing face index, with every
+/// vertex below `vertex_count`. No hashing and no full sort: a counting sort by the
+/// lowest vertex keeps the given order within each bucket, and a stable sort of each
+/// (small) bucket by the other two vertices keeps it among equal sets. Linear in the
+/// input; the per-bucket sorts run on rayon's pool and cannot depend on it.
+pub(crate) fn group_equal_sets(
+    sets: Vec<([u32; 3], u32)>,
+    vertex_count: usize,
+) -> Vec<([u32; 3], u32)> {
+    let mut bucket_start = vec![0u32; vertex_count + 1];
+    for (set, _) in &sets {
+        bucket_start[set[0] as usize + 1] += 1;
+    }
+    for i in 0..vertex_count {
+        bucket_start[i + 1] += bucket_start[i];
+    }
+    let mut grouped = vec![([0u32; 3], 0u32); sets.len()];
+    let mut fill = bucket_start;
+    for &(set, t) in &sets {
+        grouped[fill[set[0] as usize] as usize] = (set, t);
+        fill[set[0] as usize] += 1;
+    }
+    grouped
+        .par_chunk_by_mut(|x, y| x.0[0] == y.0[0])
+        .for_each(|bucket| bucket.sort_by_key(|(set, _)| (set[1], set[2])));
+    grouped
 }
 
 #[cfg(test)]

@@ -12,6 +12,8 @@
 //! model puts every point in a few cells and costs O(n²) distance tests; the per-vertex
 //! cap bounds the output (at most n·k pairs) but not those tests.
 
+use rayon::prelude::*;
+
 /// Why 1e-9: the cell coordinate `p / s` is rounded to within a few ulps (relative
 /// 1e-16 each); enlarging the cell by 1e-9 keeps two points closer than `t` at most one
 /// cell apart with a margin of many orders of magnitude, while adding a negligible
@@ -57,7 +59,9 @@ pub struct VirtualPairs {
 }
 
 /// Every pair of `points` closer than the threshold for which `allowed(i, j)` (called
-/// with `i < j`) is true, subject to the cap. Points must be finite.
+/// with `i < j`, possibly more than once per pair and from several threads) is true,
+/// subject to the cap. Points must be finite. The work is shared among rayon's
+/// threads; the result does not depend on their number.
 ///
 /// ```
 /// use qem_mesh::pairs::{virtual_pairs, GridOptions};
@@ -69,7 +73,7 @@ pub struct VirtualPairs {
 pub fn virtual_pairs(
     points: &[[f64; 3]],
     options: &GridOptions,
-    mut allowed: impl FnMut(u32, u32) -> bool,
+    allowed: impl Fn(u32, u32) -> bool + Sync,
 ) -> VirtualPairs {
     let t = options.threshold;
     if !(t > 0.0 && t.is_finite()) || options.max_per_vertex == 0 || points.len() < 2 {
@@ -79,48 +83,52 @@ pub fn virtual_pairs(
     // `as i64` saturates, so far-away points share the extreme cells: more tests, never
     // a wrong answer, because every candidate is checked by its true distance.
     let cell_of = |p: &[f64; 3]| p.map(|c| (c / size).floor() as i64);
+    // (cell, index) pairs are distinct: the parallel unstable sort has one result.
     let mut sorted: Vec<([i64; 3], u32)> = points
-        .iter()
+        .par_iter()
         .enumerate()
         .map(|(i, p)| (cell_of(p), i as u32))
         .collect();
-    sorted.sort_unstable();
+    sorted.par_sort_unstable();
 
     let t2 = t * t;
     let k = options.max_per_vertex;
-    // Per point, its nearest allowed candidates (distance², other index), at most k.
-    let mut nearest: Vec<Vec<(f64, u32)>> = vec![Vec::new(); points.len()];
-    let mut total = 0usize;
-    for (cell, i) in &sorted {
-        let p = points[*i as usize];
-        for key in neighbour_cells(*cell) {
-            let start = sorted.partition_point(|(c, _)| *c < key);
-            for (c, j) in &sorted[start..] {
-                if *c != key {
-                    break;
-                }
-                // Each unordered pair once: from its lower index.
-                if *j <= *i {
-                    continue;
-                }
-                let d2 = squared_distance(p, points[*j as usize]);
-                if d2 < t2 && allowed(*i, *j) {
-                    total += 1;
-                    offer(&mut nearest[*i as usize], (d2, *j), k);
-                    offer(&mut nearest[*j as usize], (d2, *i), k);
+    // Each point gathers its own nearest allowed candidates (distance², other index),
+    // at most k, looking at every partner on both sides. A pair is thus examined from
+    // both ends — twice the distance tests of a one-sided scan — but every point is
+    // independent, so the points are shared among threads and the lists do not depend
+    // on how. `total` counts each allowed close pair once, from its lower index.
+    let per_point: Vec<_> = sorted
+        .par_iter()
+        .map(|&(cell, i)| {
+            let p = points[i as usize];
+            let mut list = Vec::new();
+            let mut above = 0usize;
+            for key in neighbour_cells(cell) {
+                let start = sorted.partition_point(|(c, _)| *c < key);
+                for (c, j) in &sorted[start..] {
+                    if *c != key {
+                        break;
+                    }
+                    if *j == i {
+                        continue;
+                    }
+                    let d2 = squared_distance(p, points[*j as usize]);
+                    if d2 < t2 && allowed(i.min(*j), i.max(*j)) {
+                        above += usize::from(*j > i);
+                        offer(&mut list, (d2, *j), k);
+                    }
                 }
             }
-        }
-    }
-    let mut pairs: Vec<(u32, u32)> = nearest
-        .iter()
-        .enumerate()
-        .flat_map(|(i, list)| {
-            let i = i as u32;
-            list.iter().map(move |&(_, j)| (i.min(j), i.max(j)))
+            (i, list, above)
         })
         .collect();
-    pairs.sort_unstable();
+    let total: usize = per_point.iter().map(|(_, _, above)| above).sum();
+    let mut pairs: Vec<(u32, u32)> = per_point
+        .iter()
+        .flat_map(|(i, list, _)| list.iter().map(move |&(_, j)| ((*i).min(j), (*i).max(j))))
+        .collect();
+    pairs.par_sort_unstable();
     pairs.dedup();
     let capped = total - pairs.len();
     VirtualPairs { pairs, capped }
