@@ -482,7 +482,10 @@ impl Engine {
         // edges and from distinct grid points), so contraction cannot fail.
         let contracted = match &mut self.exact {
             Some(exact) => exact.contract(&mut self.store, a, b, ab, world.to_array()),
-            None => self.store.contract(a, b, world.to_array()).map(|_| ()),
+            None => self
+                .store
+                .contract_along(a, b, ab, world.to_array(), None)
+                .map(|_| ()),
         };
         if contracted.is_err() {
             return;
