@@ -34,14 +34,17 @@ fn is_current(state: &SecondaryMap<VertexKey, VertexState>, c: &Candidate) -> bo
     }
 }
 
-/// What the loop keeps per vertex.
+/// What the loop keeps per vertex: what the placement and the checks read on every
+/// pair, side by side. Why the position is here too (the store has it in world units):
+/// one lookup instead of two, and no conversion per read; it is always exactly
+/// `frame.to_normalized(store.position(v))`, so results are the same bit for bit.
 #[derive(Clone, Debug, Default)]
 pub(super) struct VertexState {
     pub quadric: Quadric,
+    /// The position in normalised units.
+    pub position: DVec3,
     /// Bumped whenever the quadric or position changes; see [`crate::queue`].
     pub stamp: u32,
-    /// Virtual-pair partners (vertices within t that share no edge).
-    pub partners: SmallVec<[VertexKey; 4]>,
     /// Never moves, never disappears.
     pub locked: bool,
     /// Index in the cleaned mesh (for [`Contraction`] events).
@@ -116,6 +119,9 @@ pub(super) struct Engine {
     /// The (unnormalised) normal of every input face, for the fold-over check and
     /// [`Engine::flipped_faces`].
     pub original_normals: SecondaryMap<FaceKey, DVec3>,
+    /// Virtual-pair partners (vertices within t that share no edge) of the vertices
+    /// that have any; kept apart from [`VertexState`] since most vertices have none.
+    partners: SecondaryMap<VertexKey, SmallVec<[VertexKey; 4]>>,
     /// Reused buffer of the neighbours of a vertex and the edge to each.
     scratch: Vec<(VertexKey, Option<EdgeKey>)>,
     /// Reused buffer of the faces around a vertex.
@@ -144,6 +150,7 @@ impl Engine {
             queue: PairQueue::with_capacity(store.edge_count() * 2),
             exact: (options.quadrics == QuadricMode::Exact).then(|| ExactQuadrics::new(&store)),
             original_normals: SecondaryMap::with_capacity(store.face_count()),
+            partners: SecondaryMap::new(),
             store,
             frame,
             settings,
@@ -154,8 +161,12 @@ impl Engine {
     }
 
     pub fn normalized_position(&self, v: VertexKey) -> DVec3 {
-        self.frame
-            .to_normalized(DVec3::from_array(self.store.position(v)))
+        match self.state.get(v) {
+            Some(s) => s.position,
+            None => self
+                .frame
+                .to_normalized(DVec3::from_array(self.store.position(v))),
+        }
     }
 
     /// Face quadrics summed into vertex quadrics, border planes or locks, locked
@@ -173,6 +184,9 @@ impl Engine {
                 v,
                 VertexState {
                     index: i as u32,
+                    position: self
+                        .frame
+                        .to_normalized(DVec3::from_array(self.store.position(v))),
                     ..VertexState::default()
                 },
             );
@@ -299,13 +313,22 @@ impl Engine {
         self.counters.virtual_pairs_capped = found.capped;
         for (i, j) in found.pairs {
             let (a, b) = (keys[i as usize], keys[j as usize]);
-            if let Some(s) = self.state.get_mut(a) {
-                s.partners.push(b);
-            }
-            if let Some(s) = self.state.get_mut(b) {
-                s.partners.push(a);
-            }
+            self.add_partner(a, b);
+            self.add_partner(b, a);
             self.push_pair(a, b, None);
+        }
+    }
+
+    /// Lists `p` among the virtual partners of `v`, if `v` is live.
+    fn add_partner(&mut self, v: VertexKey, p: VertexKey) {
+        if !self.state.contains_key(v) {
+            return;
+        }
+        match self.partners.get_mut(v) {
+            Some(list) => list.push(p),
+            None => {
+                self.partners.insert(v, SmallVec::from_slice(&[p]));
+            }
         }
     }
 
@@ -325,7 +348,7 @@ impl Engine {
             None
         };
         if let Some((v, rule)) = fixed {
-            let position = self.normalized_position(v);
+            let position = if v == a { sa.position } else { sb.position };
             let cost = q.evaluate(position).max(0.0);
             return (
                 Placement {
@@ -336,7 +359,7 @@ impl Engine {
                 q,
             );
         }
-        let (pa, pb) = (self.normalized_position(a), self.normalized_position(b));
+        let (pa, pb) = (sa.position, sb.position);
         let placed = match self.settings.placement {
             PlacementMode::Optimal => optimal_placement(&q, pa, pb),
             PlacementMode::EndpointOrMidpoint => endpoint_placement(&q, pa, pb),
@@ -482,35 +505,22 @@ impl Engine {
         // edges and from distinct grid points), so contraction cannot fail.
         let contracted = match &mut self.exact {
             Some(exact) => exact.contract(&mut self.store, a, b, ab, world.to_array()),
-            None => self.store.contract(a, b, world.to_array()).map(|_| ()),
+            None => self
+                .store
+                .contract_along(a, b, ab, world.to_array(), None)
+                .map(|_| ()),
         };
         if contracted.is_err() {
             return;
         }
 
-        // Merge b's virtual partners into a's, re-pointing the partners' lists.
-        let b_state = self.state.remove(b).unwrap_or_default();
-        for &p in &b_state.partners {
-            if let Some(ps) = self.state.get_mut(p) {
-                ps.partners.retain(|x| *x != b);
-                if p != a && !ps.partners.contains(&a) {
-                    ps.partners.push(a);
-                }
-            }
+        self.state.remove(b);
+        if !self.partners.is_empty() {
+            self.merge_partners(a, b);
         }
-        let mut partners = std::mem::take(&mut self.state[a].partners);
-        partners.retain(|x| *x != b);
-        for &p in &b_state.partners {
-            if p != a && !partners.contains(&p) {
-                partners.push(p);
-            }
-        }
-        // A virtual pair that became an edge is an edge from now on.
-        let store = &self.store;
-        partners.retain(|p| store.contains_vertex(*p) && store.find_edge(a, *p).is_none());
         let sa = &mut self.state[a];
-        sa.partners = partners;
         sa.quadric = q;
+        sa.position = self.frame.to_normalized(world);
         sa.stamp = sa.stamp.wrapping_add(1);
 
         // Re-cost every pair around the new vertex.
@@ -522,11 +532,40 @@ impl Engine {
                 .iter()
                 .filter_map(|&e| self.store.other_vertex(e, a).map(|n| (n, Some(e)))),
         );
-        neighbours.extend(self.state[a].partners.iter().map(|&p| (p, None)));
+        if let Some(partners) = self.partners.get(a) {
+            neighbours.extend(partners.iter().map(|&p| (p, None)));
+        }
         for &(n, e) in &neighbours {
             self.push_pair(a, n, e);
         }
         self.scratch = neighbours;
+    }
+
+    /// Merges the virtual partners of `b` (just removed) into those of `a`, re-pointing
+    /// the partners' lists, and drops the partners that are now joined to `a` by an edge
+    /// (a virtual pair that became an edge is an edge from now on).
+    fn merge_partners(&mut self, a: VertexKey, b: VertexKey) {
+        let b_partners = self.partners.remove(b).unwrap_or_default();
+        for &p in &b_partners {
+            if let Some(ps) = self.partners.get_mut(p) {
+                ps.retain(|x| *x != b);
+            }
+            if p != a && self.partners.get(p).is_none_or(|ps| !ps.contains(&a)) {
+                self.add_partner(p, a);
+            }
+        }
+        let mut partners = self.partners.remove(a).unwrap_or_default();
+        partners.retain(|x| *x != b);
+        for &p in &b_partners {
+            if p != a && !partners.contains(&p) {
+                partners.push(p);
+            }
+        }
+        let store = &self.store;
+        partners.retain(|p| store.contains_vertex(*p) && store.find_edge(a, *p).is_none());
+        if !partners.is_empty() {
+            self.partners.insert(a, partners);
+        }
     }
 
     /// Faces whose normal now points more than 90° from the input face they descend

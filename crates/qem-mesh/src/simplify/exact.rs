@@ -110,7 +110,7 @@ impl ExactQuadrics {
                 }
             }
         }
-        store.contract_logged(a, b, position, log)?;
+        store.contract_along(a, b, ab, position, Some(log))?;
         for &(removed, kept) in &log.faces_merged {
             let q = faces.remove(removed).unwrap_or(Quadric::ZERO);
             if let Some(sum) = faces.get_mut(kept) {

@@ -140,7 +140,9 @@ impl MeshStore {
         b: VertexKey,
         position: [f64; 3],
     ) -> Result<ContractOutcome, ContractError> {
-        self.contract_impl(a, b, position, None)
+        self.check_contract(a, b, position)?;
+        let ab = self.find_edge(a, b);
+        Ok(self.contract_checked(a, b, ab, position, None))
     }
 
     /// [`contract`](Self::contract) that also writes into `log` (cleared first) which
@@ -177,16 +179,44 @@ impl MeshStore {
         log: &mut ContractLog,
     ) -> Result<ContractOutcome, ContractError> {
         log.clear();
-        self.contract_impl(a, b, position, Some(log))
+        self.check_contract(a, b, position)?;
+        let ab = self.find_edge(a, b);
+        Ok(self.contract_checked(a, b, ab, position, Some(log)))
     }
 
-    fn contract_impl(
+    /// [`contract`](Self::contract) (or [`contract_logged`](Self::contract_logged) when
+    /// `log` is given) for a caller that already looked up the edge `ab` joining `a`
+    /// and `b` (`None` for a virtual pair). Why: the simplifier needs that edge for its
+    /// checks, and a second search of the smaller star per contraction is measurable.
+    ///
+    /// `ab` must be `self.find_edge(a, b)` (checked in debug builds).
+    ///
+    /// # Errors
+    /// As [`contract`](Self::contract).
+    pub(crate) fn contract_along(
         &mut self,
         a: VertexKey,
         b: VertexKey,
+        ab: Option<EdgeKey>,
         position: [f64; 3],
         mut log: Option<&mut ContractLog>,
     ) -> Result<ContractOutcome, ContractError> {
+        if let Some(log) = log.as_deref_mut() {
+            log.clear();
+        }
+        self.check_contract(a, b, position)?;
+        debug_assert_eq!(ab, self.find_edge(a, b));
+        Ok(self.contract_checked(a, b, ab, position, log))
+    }
+
+    /// The refusals of [`contract`](Self::contract): same vertex, dead key, non-finite
+    /// position.
+    fn check_contract(
+        &self,
+        a: VertexKey,
+        b: VertexKey,
+        position: [f64; 3],
+    ) -> Result<(), ContractError> {
         if a == b {
             return Err(ContractError::SameVertex(a));
         }
@@ -198,7 +228,19 @@ impl MeshStore {
         if !position.iter().all(|c| c.is_finite()) {
             return Err(ContractError::NonFinitePosition(position));
         }
+        Ok(())
+    }
 
+    /// The contraction itself, once [`check_contract`](Self::check_contract) passed;
+    /// `ab` is the edge joining `a` and `b`, if any.
+    fn contract_checked(
+        &mut self,
+        a: VertexKey,
+        b: VertexKey,
+        ab: Option<EdgeKey>,
+        position: [f64; 3],
+        mut log: Option<&mut ContractLog>,
+    ) -> ContractOutcome {
         let mut outcome = ContractOutcome::default();
         // Taken out of `self` for the duration so the borrow checker lets us mutate the
         // store while walking them; put back at the end to keep their capacity.
@@ -206,7 +248,7 @@ impl MeshStore {
         let mut edges = std::mem::take(&mut self.scratch.edges);
 
         // Step 1: the faces on edge a-b collapse, then the edge itself.
-        if let Some(ab) = self.find_edge(a, b) {
+        if let Some(ab) = ab {
             faces.clear();
             faces.extend_from_slice(&self.edges[ab].fan);
             for &f in &faces {
@@ -278,7 +320,7 @@ impl MeshStore {
 
         self.scratch.faces = faces;
         self.scratch.edges = edges;
-        Ok(outcome)
+        outcome
     }
 
     /// The face on vertices `{a, x, y}` (any orientation), if any: a search of one star
