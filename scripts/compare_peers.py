@@ -24,6 +24,22 @@ Time: peers = the simplification call alone (timed by the harness); qem = the wh
 process including start-up and OBJ read/write (the harness cannot time inside a CLI),
 with qem's own simplification time from its --report in brackets when available.
 
+Peer cache: the peers' rows do not depend on qem, so every measured peer row is stored
+as one JSON file in `--peer-cache DIR` (default `$PEERS_HOME/compare-peers-cache`),
+keyed on the mesh (name + SHA-256 of the OBJ), the ratio, the tool and the harness's
+options (SHA-256 of `peers.py`, `--repeat`, `--timeout`, `--slow-cap`). A mesh whose
+peer rows are all cached runs the harness for qem alone; `--no-peer-cache` measures the
+peers again. `--seed-peer-cache FILE` fills the cache from the table of a previous run in
+FILE (a BENCHMARKS.md with the compare-peers block): those rows carry the table's
+rounding (4 decimals of % diag) and are marked `from_table` in the cache.
+
+`--boundary` (with `--meshes`, default: every corpus mesh whose manifest `boundary_edges`
+> 0) runs qem alone at the first of `--ratios` with the defaults and with
+`--lock-boundary` and writes the boundary loops (harness count, by index) of the file, of
+qem's cleaned input (`--triangles 1000000000`, the reference: soups have one loop per
+triangle in the file) and of both outputs between
+`<!-- boundary-loops:start -->` and `<!-- boundary-loops:end -->`.
+
 `--variant NAME='ARGS'` adds another qem row with extra `qem simplify` arguments (e.g.
 `--variant qem_pb='--preserve-boundary'` once that option exists); variants are shown but
 not counted as peers or as qem in the win counts.
@@ -40,6 +56,7 @@ Python 3 standard library only; the harness runs in its own venv.
 Build first: `cargo build --release -p qem-cli`.
 """
 import argparse
+import hashlib
 import json
 import os
 import shlex
@@ -51,6 +68,7 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 START, END = "<!-- compare-peers:start -->", "<!-- compare-peers:end -->"
 AGREE_START, AGREE_END = "<!-- measure-agreement:start -->", "<!-- measure-agreement:end -->"
+BOUNDARY_START, BOUNDARY_END = "<!-- boundary-loops:start -->", "<!-- boundary-loops:end -->"
 CLEAN_ZERO_COLUMNS = ["duplicate_vertices", "duplicate_faces", "degenerate_faces",
                       "nonmanifold_edges", "nonmanifold_vertices"]
 
@@ -142,7 +160,78 @@ def qem_call_ms(report_dir, tool, mesh, ratio):
         return None
 
 
-def compare(args, corpus, names, peers, py):
+def sha256_file(path):
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for chunk in iter(lambda: f.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+class PeerCache:
+    """Peer rows on disk, one JSON file per (mesh content, ratio, tool, harness options)."""
+
+    def __init__(self, directory, peers, args):
+        self.dir = directory
+        self.options = {"peers_py": sha256_file(peers), "repeat": args.repeat,
+                        "timeout": args.timeout, "slow_cap": args.slow_cap}
+        self.mesh_sha = {}
+
+    def _path(self, mesh_path, ratio, tool):
+        if mesh_path not in self.mesh_sha:
+            self.mesh_sha[mesh_path] = sha256_file(mesh_path)
+        key = json.dumps({"mesh": os.path.basename(mesh_path), "sha256": self.mesh_sha[mesh_path],
+                          "ratio": float(ratio), "tool": tool, **self.options}, sort_keys=True)
+        return os.path.join(self.dir, hashlib.sha256(key.encode()).hexdigest()[:32] + ".json")
+
+    def get(self, mesh_path, ratio, tool):
+        try:
+            with open(self._path(mesh_path, ratio, tool)) as f:
+                return json.load(f)
+        except (OSError, ValueError):
+            return None
+
+    def put(self, mesh_path, ratio, tool, record):
+        os.makedirs(self.dir, exist_ok=True)
+        path = self._path(mesh_path, ratio, tool)
+        with open(path + ".tmp", "w") as f:
+            json.dump(record, f, indent=1, default=float)
+        os.replace(path + ".tmp", path)
+
+
+def seed_cache_from_table(cache, table_file, corpus, tools):
+    """Peer rows of a previous compare-peers table -> cache (rounded as printed)."""
+    text = open(table_file).read()
+    if START not in text or END not in text:
+        sys.exit(f"{table_file}: no {START} block to seed from")
+    block = text.split(START, 1)[1].split(END, 1)[0]
+    n = 0
+    for line in block.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) != 9 or cells[2] not in tools or cells[3].startswith("FAILED"):
+            continue
+        mesh, ratio, tool, tris, ms, hd, mean, flipped, loops = cells
+        try:
+            rec = {"mesh": mesh, "ratio": float(ratio), "tool": tool, "status": "ok",
+                   "tris_out": int(tris), "t_call": float(ms.replace(",", "")) / 1e3,
+                   "hd_sym": float(hd) / 100, "mean_sym": float(mean) / 100,
+                   "flipped_pct": None if flipped == "-" else float(flipped),
+                   "from_table": os.path.abspath(table_file)}
+        except ValueError:
+            continue
+        if loops != "-":
+            io, _, verdict = loops.partition(" ")
+            a, b = io.split("→")
+            rec.update(boundary_loops_in=int(a), boundary_loops_out=int(b),
+                       boundary_survived={"ok": True, "LOST": False}.get(verdict))
+        path = os.path.join(corpus, mesh + ".obj")
+        if os.path.isfile(path):
+            cache.put(path, rec["ratio"], tool, rec)
+            n += 1
+    print(f"[compare] seeded {n} peer rows from {table_file} into {cache.dir}")
+
+
+def compare(args, corpus, names, peers, py, cache):
     ratios = [float(r) for r in args.ratios.split(",")]
     tools = [t for t in args.tools.split(",") if t]
     variants = []
@@ -159,10 +248,25 @@ def compare(args, corpus, names, peers, py):
         path = os.path.join(corpus, mesh + ".obj")
         cmds = [(n, qem_template(args.qem, extra, report_dir, f"{mesh}.{n}", with_report))
                 for n, extra in [("qem", args.qem_args)] + variants]
-        for r in run_harness(py, peers, path, ratios, tools, cmds, args, os.path.join(work, "results")):
+        cached = {(t, r): cache.get(path, r, t) for t in tools for r in ratios} if cache else {}
+        run_tools = [t for t in tools if any(cached.get((t, r)) is None for r in ratios)]
+        if cache and len(run_tools) < len(tools):
+            print(f"[compare] {mesh}: peer rows from the cache for "
+                  f"{', '.join(t for t in tools if t not in run_tools)}", flush=True)
+        fresh = run_harness(py, peers, path, ratios, run_tools, cmds, args, os.path.join(work, "results"))
+        by_key = {(r["tool"], float(r["ratio"])): r for r in fresh}
+        for r in fresh:
             if r["tool"] == "qem" or r["tool"] in dict(variants):
                 r["qem_call_ms"] = qem_call_ms(report_dir, r["tool"], mesh, r["ratio"])
-            records.append(r)
+            elif cache and r.get("status") == "ok":
+                cache.put(path, r["ratio"], r["tool"], r)
+        for ratio in ratios:
+            for t in tools:
+                if (t, ratio) in by_key:
+                    records.append(by_key[(t, ratio)])
+                elif cached.get((t, ratio)) is not None:
+                    records.append(dict(cached[(t, ratio)], cached=True))
+            records += [by_key[(n, ratio)] for n in ["qem"] + [v for v, _ in variants] if (n, ratio) in by_key]
         print(f"[compare] {mesh} done ({time.time() - t_start:.0f}s so far)", flush=True)
     return records, tools, [n for n, _ in variants], ratios, time.time() - t_start
 
@@ -298,6 +402,51 @@ def agreement(args, corpus, names, peers, py):
     return "\n".join(rows + summary)
 
 
+def boundary_loops(args, corpus, names, peers, py):
+    """qem at one ratio, defaults vs --lock-boundary: boundary loops in->out as the harness counts them.
+
+    The harness counts loops by vertex index, so an unwelded input (a triangle soup) has one
+    loop per triangle. The reference is therefore qem's own cleaned input: `qem simplify
+    --ratio 1` (load, weld, clean, no contraction), measured by the same harness.
+    """
+    ratio = float(args.ratios.split(",")[0])
+    work = tempfile.mkdtemp(prefix="compare_boundary_")
+    rows = ["| mesh | tris in | loops in (file) | loops after cleaning (ratio 1) | defaults: loops out | "
+            "defaults: boundary HD %diag | --lock-boundary: loops out | --lock-boundary: boundary HD %diag |",
+            "|---|---|---|---|---|---|---|---|"]
+    kept = {"qem": 0, "qem_lock": 0}
+    n = 0
+    for mesh in names:
+        path = os.path.join(corpus, mesh + ".obj")
+        ref = f"{shlex.quote(args.qem)} simplify {{in}} -o {{out}} --triangles 1000000000 -q"
+        cmds = [("qem_clean", ref),
+                ("qem", qem_template(args.qem, args.qem_args, work, mesh, False)),
+                ("qem_lock", qem_template(args.qem, (args.qem_args + " --lock-boundary").strip(), work, mesh, False))]
+        recs = {r["tool"]: r for r in run_harness(py, peers, path, [ratio], [], cmds, args, os.path.join(work, "h"))}
+        clean = recs.get("qem_clean", {})
+        ref_loops = clean.get("boundary_loops_out") if clean.get("status") == "ok" else None
+        cells = []
+        for tool in ("qem", "qem_lock"):
+            r = recs.get(tool, {})
+            if r.get("status") != "ok":
+                cells += ["FAILED: " + str(r.get("error", "no record"))[:60].replace("|", "/"), ""]
+                continue
+            same = ref_loops is not None and r.get("boundary_loops_out") == ref_loops
+            kept[tool] += same
+            bhd = r.get("boundary_hd")
+            cells += [f"{r.get('boundary_loops_out')}" + ("" if same else " **changed**"),
+                      "-" if bhd is None else pct(bhd)]
+        n += 1
+        rows.append(f"| {mesh} | {clean.get('tris_in', '-')} | {clean.get('boundary_loops_in', '-')} | "
+                    f"{'-' if ref_loops is None else ref_loops} | " + " | ".join(cells) + " |")
+        print(rows[-1], flush=True)
+    summary = (f"Ratio {ratio}, {n} meshes: the number of boundary loops after cleaning is kept on "
+               f"**{kept['qem']}/{n}** with the defaults and **{kept['qem_lock']}/{n}** with `--lock-boundary`. "
+               "Boundary HD = the harness's sampled Hausdorff distance between the input's and the "
+               "output's boundary edges (both directions).")
+    return summary + "\n\n" + "\n".join(rows)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--corpus", default=os.environ.get("QEM_CORPUS", os.path.join(ROOT, "..", "shared", "corpus")))
@@ -314,6 +463,13 @@ def main():
     ap.add_argument("--slow-cap", type=float, default=60)
     ap.add_argument("--out", default=os.path.join(ROOT, "BENCHMARKS.md"))
     ap.add_argument("--agreement", default="", help="comma list of meshes: qem measure vs the harness")
+    ap.add_argument("--peer-cache", default=os.path.join(
+        os.environ.get("PEERS_HOME", os.path.join(os.path.expanduser("~"), ".cache", "qem-peers")),
+        "compare-peers-cache"), help="directory of cached peer rows")
+    ap.add_argument("--no-peer-cache", action="store_true", help="measure the peers again, cache nothing")
+    ap.add_argument("--seed-peer-cache", default="", help="FILE: fill the cache from FILE's compare-peers table")
+    ap.add_argument("--boundary", action="store_true",
+                    help="boundary loops, qem defaults vs --lock-boundary, on meshes with borders")
     args = ap.parse_args()
     args.corpus, args.peers_dir, args.qem = (os.path.normpath(p) for p in (args.corpus, args.peers_dir, args.qem))
 
@@ -336,6 +492,18 @@ def main():
         print(body)
         return 0
 
+    if args.boundary:
+        if peers is None:
+            print(f"harness not found ({args.peers_dir}, venv python): cannot count loops with it")
+            return 0
+        names = ([n for n in args.meshes.split(",") if n]
+                 or [mesh_name(r) for r in rows if int(r["boundary_edges"]) > 0])
+        command = "scripts/compare_peers.py " + " ".join(shlex.quote(a) for a in sys.argv[1:])
+        body = f"`{command.strip()}`\n\n" + boundary_loops(args, args.corpus, names, peers, py)
+        replace_between(args.out, BOUNDARY_START, BOUNDARY_END, body, "## Boundary loops (issue 5)")
+        print(body)
+        return 0
+
     names = [n for n in args.meshes.split(",") if n] or clean
     if peers is None:
         print(f"harness not found ({args.peers_dir}/peers.py and its venv python): running qem alone")
@@ -345,13 +513,36 @@ def main():
         print(body)
         return 0
 
-    records, tools, variants, ratios, seconds = compare(args, args.corpus, names, peers, py)
+    tools = [t for t in args.tools.split(",") if t]
+    cache = None if args.no_peer_cache else PeerCache(args.peer_cache, peers, args)
+    if args.seed_peer_cache:
+        if cache is None:
+            sys.exit("--seed-peer-cache needs the cache (drop --no-peer-cache)")
+        seed_cache_from_table(cache, args.seed_peer_cache, args.corpus, tools)
+    records, tools, variants, ratios, seconds = compare(args, args.corpus, names, peers, py, cache)
+    from_table = sorted({r["from_table"] for r in records if r.get("from_table")})
+    n_cached = sum(1 for r in records if r["tool"] in tools and r.get("cached"))
     summary, _ = wins(records, tools, set(clean))
+    for v in variants:
+        # Each variant counted as if it were qem (its rows renamed), against the same peers.
+        renamed = [dict(r, tool="qem") for r in records if r["tool"] == v] + \
+                  [r for r in records if r["tool"] in tools]
+        _, counts = wins(renamed, tools, set(clean))
+        if counts:
+            mw, hw, n = counts
+            summary += (f"\n- variant `{v}` in qem's place: mean ≤ best peer's {mw}/{n} = {100 * mw / n:.0f}%, "
+                        f"Hausdorff ≤ best peer's {hw}/{n} = {100 * hw / n:.0f}%")
     command = "scripts/compare_peers.py " + " ".join(shlex.quote(a) for a in sys.argv[1:])
     body = "\n".join([
         f"`{command.strip()}` — meshes: {', '.join(names)}; ratios {', '.join(map(str, ratios))}; "
         f"peers: {', '.join(tools)}" + (f"; qem variants: {', '.join(variants)}" if variants else "")
         + f"; qem args: `{args.qem_args or '(defaults)'}`; total {seconds / 60:.1f} min.",
+        "",
+        (f"{n_cached} peer rows came from the peer cache (measured by an earlier run with the same "
+         "harness, options and mesh files)"
+         + (f"; seeded from the table of {', '.join(os.path.basename(f) for f in from_table)} "
+            "as printed there, i.e. rounded to 4 decimals of % diag" if from_table else "")
+         + "." if n_cached else "All peer rows measured in this run."),
         "",
         "Distances in % of the input's bbox diagonal, measured by the harness for every tool alike "
         "(Hausdorff = max of both directions; mean = average of the two directed means). "
