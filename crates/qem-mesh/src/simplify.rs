@@ -9,7 +9,7 @@
 //! in `[-1, 1]`), while the store keeps world coordinates, so vertices that are never
 //! moved come out bit for bit as they went in.
 
-use crate::clean::{clean, min_double_area, CleanOptions, CleanReport};
+use crate::clean::{clean, cross_underflows, min_double_area, CleanOptions, CleanReport};
 use crate::pairs::grid::{virtual_pairs, GridOptions};
 use crate::queue::{Candidate, PairQueue};
 use crate::store::{FaceKey, MeshStore, StoreError, VertexKey};
@@ -794,7 +794,17 @@ impl Engine {
                     }
                 });
                 let double_area = (p1 - p0).cross(p2 - p0).length();
-                if double_area.is_nan() || double_area <= self.min_double_area {
+                let world_corners = corners.map(|c| {
+                    if c == a || c == b {
+                        world.to_array()
+                    } else {
+                        self.store.position(c)
+                    }
+                });
+                if double_area.is_nan()
+                    || double_area <= self.min_double_area
+                    || cross_underflows(world_corners)
+                {
                     degenerate = true;
                     break;
                 }
