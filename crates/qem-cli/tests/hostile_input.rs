@@ -519,3 +519,27 @@ fn many_coincident_faces_clean_to_one() {
     let mesh = assert_simplified("coincident_faces.stl", &binary_stl(100_000, 100_000));
     assert_eq!(mesh.triangle_count(), 1);
 }
+
+#[test]
+fn gzip_that_expands_too_much_is_refused() {
+    // A million copies of one face compress about 680:1 as OBJ text; the reader refuses
+    // more than 64:1 rather than hold the whole expansion in memory.
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let source = dir.path().join("coincident.obj.gz");
+    let mesh = qem_mesh::IndexedMesh::new(
+        vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        vec![[0, 1, 2]; 1_000_000],
+    );
+    qem_mesh::io::write_path(&source, &mesh).expect("the gzip file is written");
+    let bytes = std::fs::read(&source).expect("readable");
+    let limit = bytes.len() as u64 * qem_mesh::io::GZIP_MAX_RATIO + (1 << 16);
+    assert_refused(
+        "coincident.obj.gz",
+        &bytes,
+        &format!(
+            "gzip: decompresses to more than {limit} bytes ({}x the compressed size, at most {})",
+            qem_mesh::io::GZIP_MAX_RATIO,
+            qem_mesh::io::GZIP_MAX_BYTES
+        ),
+    );
+}
