@@ -18,8 +18,11 @@ pub use readers::{read_obj, read_off, read_ply, read_stl};
 pub use simplify_soup::simplify_soup;
 pub use store_ops::store_ops;
 
+/// A fuzz check: panics on arbitrary bytes only when the property is violated.
+pub type Check = fn(&[u8]);
+
 /// Every fuzz target by name with its check, for the replay test and for tools.
-pub const TARGETS: [(&str, fn(&[u8])); 8] = [
+pub const TARGETS: [(&str, Check); 8] = [
     ("quadric_solve", quadric_solve),
     ("simplify_soup", simplify_soup),
     ("store_ops", store_ops),

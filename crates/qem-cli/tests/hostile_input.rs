@@ -202,7 +202,7 @@ fn non_finite_coordinates_are_refused_with_their_line() {
     // 1e400 is beyond f64: it parses to infinity.
     assert_refused(
         "overflow.obj",
-        format!("v 0 0 0\nv 1e400 0 0\nv 0 1 0\nf 1 2 3\n").as_bytes(),
+        b"v 0 0 0\nv 1e400 0 0\nv 0 1 0\nf 1 2 3\n",
         "line 2: vertex 1 has a non-finite coordinate",
     );
     let mut ply = ply_header(3, 1, "uchar");
