@@ -543,3 +543,27 @@ fn gzip_that_expands_too_much_is_refused() {
         ),
     );
 }
+
+#[test]
+fn missing_files_and_directories_are_refused() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let folder = dir.path().join("folder.obj");
+    std::fs::create_dir(&folder).expect("a directory");
+    let output = dir.path().join("out.ply");
+    for input in [dir.path().join("missing.obj"), folder] {
+        let o = Command::new(env!("CARGO_BIN_EXE_qem"))
+            .arg("simplify")
+            .arg(&input)
+            .arg("-o")
+            .arg(&output)
+            .output()
+            .expect("qem runs");
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{stderr}");
+        // The rest is the operating system's wording (e.g. "Is a directory (os error 21)").
+        let prefix = format!("qem: error: {}: cannot read: ", input.display());
+        assert!(stderr.starts_with(&prefix), "{stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+        assert!(!output.exists());
+    }
+}
