@@ -253,6 +253,40 @@ fn bad_indices_are_refused_with_their_line() {
 }
 
 #[test]
+fn bad_indices_in_ply_and_stl_nan_are_refused_with_their_place() {
+    let mut ply = ply_header(3, 1, "uchar");
+    let face = ply.len() + 36;
+    ply.extend(ply_triangle_vertices());
+    let mut negative = ply.clone();
+    negative.push(3);
+    negative.extend([0i32, -1, 2].iter().flat_map(|i| i.to_le_bytes()));
+    assert_refused(
+        "negative.ply",
+        &negative,
+        &format!(
+            "byte {}: face 0 refers to vertex -1, but there are only 3 vertices",
+            face + 5
+        ),
+    );
+    ply.push(3);
+    ply.extend([0i32, 1, 3].iter().flat_map(|i| i.to_le_bytes()));
+    assert_refused(
+        "out_of_range.ply",
+        &ply,
+        &format!(
+            "byte {}: face 0 refers to vertex 3, but there are only 3 vertices",
+            face + 9
+        ),
+    );
+    assert_refused(
+        "nan.stl",
+        b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex nan 0 0\n\
+          vertex 0 1 0\nendloop\nendfacet\nendsolid x\n",
+        "line 5: vertex 1 has a non-finite coordinate",
+    );
+}
+
+#[test]
 fn vertices_without_faces_are_refused() {
     assert_refused(
         "no_faces.obj",
