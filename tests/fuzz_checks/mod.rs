@@ -1,7 +1,7 @@
 //! The property each fuzz target checks, as plain functions that panic on a violation.
 //!
 //! A panic is how libFuzzer learns of a bug, and how a replay test fails. Each function
-//! takes arbitrary bytes and decodes them with [`bytes::Bytes`], which never fails (an
+//! takes arbitrary bytes and decodes them with a cursor (`bytes.rs`) that never fails (an
 //! exhausted input reads as zeros), so every byte string is a valid test case and the
 //! committed corpus files replay through `cargo test` exactly as libFuzzer ran them.
 
@@ -14,7 +14,7 @@ mod store_ops;
 
 pub use grid_pairs::grid_pairs;
 pub use quadric::quadric_solve;
-pub use readers::{read_obj, read_off, read_ply, read_stl};
+pub use readers::{read_checked, read_obj, read_off, read_ply, read_stl};
 pub use simplify_soup::simplify_soup;
 pub use store_ops::store_ops;
 

@@ -33,7 +33,7 @@ pub fn read_off(data: &[u8]) {
 /// same corner positions rounded to f32, triangle by triangle (an ASCII facet with more
 /// than three vertices is fanned into triangles that share them, and comes back as
 /// separate triangles).
-fn read_checked(data: &[u8], format: Format) {
+pub fn read_checked(data: &[u8], format: Format) {
     let loaded = match read_bytes(data, format) {
         Ok(loaded) => loaded,
         Err(e) => {
