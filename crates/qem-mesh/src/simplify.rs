@@ -280,6 +280,9 @@ pub enum SimplifyError {
     /// The input failed validation.
     Input(InputError),
     /// Every triangle was degenerate or a duplicate: nothing is left to simplify.
+    /// (With [`CleanOptions::drop_zero_area`] turned off, zero-area faces enter the
+    /// loop; if only such faces are left at the end, this is the error too, since the
+    /// output never has a zero-area face.)
     NothingLeftAfterCleaning {
         /// How many triangles the input had.
         triangles_in: usize,
@@ -481,9 +484,22 @@ pub fn simplify_levels(
         timings.contract += clock.elapsed();
 
         let clock = Instant::now();
-        let raw = engine.store.to_mesh();
-        let final_clean = clean(&raw, &CleanOptions::OUTPUT);
+        let mut raw = engine.store.to_mesh();
+        // Zero-area faces are judged in the loop's frame, not in the output's own (which
+        // is larger when a placement left the input's box, making the relative test
+        // stricter): the loop refused every contraction that would make a face
+        // zero-area, so this drops only faces that came in so (cleaning passes off).
+        let before = raw.triangles.len();
+        raw.triangles
+            .retain(|t| !engine.is_zero_area(t.map(|i| raw.positions[i as usize])));
+        let zero_area = before - raw.triangles.len();
+        let final_clean = clean(&raw, &CleanOptions::OUTPUT.with_drop_zero_area(false));
         let out = final_clean.mesh;
+        if out.triangles.is_empty() {
+            return Err(SimplifyError::NothingLeftAfterCleaning {
+                triangles_in: mesh.triangle_count(),
+            });
+        }
         timings.compact = clock.elapsed();
 
         let report = SimplifyReport {
@@ -501,8 +517,7 @@ pub fn simplify_levels(
             bbox_diagonal: frame.world_diagonal(),
             stop_reason,
             cleanup,
-            degenerate_faces_removed: final_clean.report.zero_area_faces
-                + final_clean.report.repeated_index_faces,
+            degenerate_faces_removed: zero_area + final_clean.report.repeated_index_faces,
             rejected_degenerate: engine.rejected_degenerate,
             timings,
         };
@@ -772,11 +787,23 @@ impl Engine {
         }
     }
 
+    /// Whether a triangle with these world corners is (numerically) zero-area for the
+    /// loop: its double area in the normalised frame is at most `min_double_area` (or
+    /// NaN), or its cross product underflows in world units. The same test decides
+    /// which contractions are refused and which faces are dropped at output, so a face
+    /// the loop kept is never dropped afterwards.
+    fn is_zero_area(&self, world_corners: [[f64; 3]; 3]) -> bool {
+        let [p0, p1, p2] = world_corners.map(|c| self.frame.to_normalized(DVec3::from_array(c)));
+        let double_area = (p1 - p0).cross(p2 - p0).length();
+        double_area.is_nan()
+            || double_area <= self.min_double_area
+            || cross_underflows(world_corners)
+    }
+
     /// Whether moving `a` and `b` to `world` would leave a surviving face of either
     /// with (numerically) zero area — such a face would be dropped at output, and if
     /// it were the last one the output would be empty.
     fn would_degenerate(&mut self, a: VertexKey, b: VertexKey, world: DVec3) -> bool {
-        let moved = self.frame.to_normalized(world);
         let mut faces = std::mem::take(&mut self.face_scratch);
         let mut degenerate = false;
         for v in [a, b] {
@@ -786,14 +813,6 @@ impl Engine {
                 if corners.contains(&a) && corners.contains(&b) {
                     continue; // collapses with the pair
                 }
-                let [p0, p1, p2] = corners.map(|c| {
-                    if c == a || c == b {
-                        moved
-                    } else {
-                        self.normalized_position(c)
-                    }
-                });
-                let double_area = (p1 - p0).cross(p2 - p0).length();
                 let world_corners = corners.map(|c| {
                     if c == a || c == b {
                         world.to_array()
@@ -801,10 +820,7 @@ impl Engine {
                         self.store.position(c)
                     }
                 });
-                if double_area.is_nan()
-                    || double_area <= self.min_double_area
-                    || cross_underflows(world_corners)
-                {
+                if self.is_zero_area(world_corners) {
                     degenerate = true;
                     break;
                 }
