@@ -96,8 +96,11 @@ pub fn simplify_soup(data: &[u8]) {
         }
         Err(SimplifyError::NothingLeftAfterCleaning { triangles_in }) => {
             assert_eq!(*triangles_in, mesh.triangle_count());
+            // With the zero-area pass off, zero-area faces enter the loop and may be all
+            // that is left at the end (documented on the error).
             assert!(
-                clean(&mesh, &options.clean).mesh.triangles.is_empty(),
+                clean(&mesh, &options.clean).mesh.triangles.is_empty()
+                    || !options.clean.drop_zero_area,
                 "refused an input with triangles left after cleaning"
             );
         }
