@@ -2,11 +2,13 @@
 //! scenarios (the raw reproducers are replayed by `fuzz_replay.rs`).
 
 use qem_mesh::clean::CleanOptions;
+use qem_mesh::pairs::{virtual_pairs, GridOptions};
 use qem_mesh::simplify::{
     simplify, Length, SimplifyError, SimplifyOptions, StopReason, Target, Weighting,
 };
 use qem_mesh::IndexedMesh;
 use qem_tests::mesh_checks::assert_valid_output;
+use qem_tests::pair_model::brute_force_pairs;
 
 /// simplify_soup finding 1 (`default_options_last_face_dropped_in_output_frame`): with
 /// unweighted quadrics and virtual pairs, placements land far outside the input's box
@@ -70,4 +72,33 @@ fn zero_area_faces_let_in_are_the_documented_error_not_an_empty_mesh() {
         simplify(&mesh, &options).unwrap_err(),
         SimplifyError::NothingLeftAfterCleaning { triangles_in: 1 }
     );
+}
+
+/// grid_pairs finding (`saturated_cell_visited_twice`): cell coordinates of points
+/// beyond ±9.2e18 cells saturate at the ends of i64, and the neighbour offsets
+/// saturated too, so the edge cell was visited twice: its pairs were counted twice
+/// (`capped` 1 instead of 0 here) and offered twice to the nearest-k lists.
+#[test]
+fn points_beyond_the_cell_range_are_counted_once() {
+    let points = [
+        [0.0, -5.573184143441918e303, 5.30515525833e-312],
+        [0.0, -5.573184143441918e303, 5.30515525833e-312],
+        [0.0, 6.713868506e-315, 0.0],
+    ];
+    let options = GridOptions::new(0.5).with_max_per_vertex(3);
+    let found = virtual_pairs(&points, &options, |_, _| true);
+    assert_eq!(found.pairs, vec![(0, 1)]);
+    assert_eq!(found.capped, 0);
+}
+
+/// The same finding, where the doubled offers crowded a pair out: three coincident
+/// points in the saturated cell with k = 2 must give all three pairs (each point's two
+/// nearest are the other two), and gave only (0, 1) and (0, 2).
+#[test]
+fn coincident_points_beyond_the_cell_range_all_pair_up() {
+    let points = [[0.0, -1e300, 0.0]; 3];
+    let options = GridOptions::new(1.0).with_max_per_vertex(2);
+    let found = virtual_pairs(&points, &options, |_, _| true);
+    assert_eq!(found.pairs, vec![(0, 1), (0, 2), (1, 2)]);
+    assert_eq!(found, brute_force_pairs(&points, 1.0, 2, |_, _| true));
 }
