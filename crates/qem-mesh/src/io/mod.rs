@@ -28,7 +28,9 @@
 //! name ends in `.gz`. OBJ and OFF are text with coordinates written in Rust's shortest
 //! round-trip form, PLY is `binary_little_endian` with `double` coordinates: all three
 //! read back bit-exact. STL is binary with `float32` coordinates (the format has no
-//! other choice) and facet normals computed from the triangles.
+//! other choice) and facet normals computed from the triangles; a coordinate beyond
+//! float32's range (about ±3.4e38) is an `InvalidInput` error rather than an infinity
+//! in the file.
 //!
 //! ```
 //! use qem_mesh::io::{read_bytes, write_to, Format};
@@ -282,8 +284,8 @@ pub fn read_path(path: &Path) -> Result<LoadedMesh, IoError> {
 }
 
 /// Writes `mesh` in `format` to `out` (uncompressed). See the [module docs](self) for
-/// the exact encodings. A triangle index out of range is an `InvalidInput` error;
-/// nothing else about the mesh is checked.
+/// the exact encodings. A triangle index out of range, or an STL coordinate beyond
+/// float32, is an `InvalidInput` error; nothing else about the mesh is checked.
 pub fn write_to<W: Write>(out: W, mesh: &IndexedMesh, format: Format) -> std::io::Result<()> {
     let n = mesh.positions.len();
     if let Some((face, &index)) = mesh
