@@ -102,3 +102,30 @@ fn coincident_points_beyond_the_cell_range_all_pair_up() {
     assert_eq!(found.pairs, vec![(0, 1), (0, 2), (1, 2)]);
     assert_eq!(found, brute_force_pairs(&points, 1.0, 2, |_, _| true));
 }
+
+/// read_stl finding (`ascii_coordinate_beyond_float32*`): an ASCII STL coordinate such
+/// as 1e39 reads as f64, but binary STL stores float32, so writing it gave infinity: a
+/// file that no reader accepts. Writing STL now refuses such a coordinate.
+#[test]
+fn stl_output_refuses_coordinates_beyond_float32() {
+    let mesh = IndexedMesh::new(
+        vec![[0.0, 0.0, 0.0], [1e39, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        vec![[0, 1, 2]],
+    );
+    let mut bytes = Vec::new();
+    let err = qem_mesh::io::write_to(&mut bytes, &mesh, qem_mesh::io::Format::Stl)
+        .expect_err("1e39 does not fit in float32");
+    assert_eq!(err.kind(), std::io::ErrorKind::InvalidInput);
+    assert_eq!(
+        err.to_string(),
+        "vertex 1 has coordinate 1e39, beyond the range of STL's float32 (about ±3.4e38); \
+         write PLY, OBJ or OFF instead"
+    );
+    // The largest float32 still fits.
+    let edge = IndexedMesh::new(
+        vec![[0.0; 3], [f64::from(f32::MAX), 0.0, 0.0], [0.0, 1.0, 0.0]],
+        vec![[0, 1, 2]],
+    );
+    let mut bytes = Vec::new();
+    qem_mesh::io::write_to(&mut bytes, &edge, qem_mesh::io::Format::Stl).expect("fits");
+}

@@ -601,3 +601,32 @@ fn missing_files_and_directories_are_refused() {
         assert!(!output.exists());
     }
 }
+
+#[test]
+fn stl_output_beyond_float32_is_refused_without_a_file() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let input = dir.path().join("huge.obj");
+    std::fs::write(&input, "v 0 0 0\nv 1e39 0 0\nv 0 1e39 0\nf 1 2 3\n").expect("written");
+    let output = dir.path().join("out.stl");
+    let o = Command::new(env!("CARGO_BIN_EXE_qem"))
+        .arg("simplify")
+        .arg(&input)
+        .arg("-o")
+        .arg(&output)
+        .output()
+        .expect("qem runs");
+    assert_eq!(o.status.code(), Some(1));
+    assert_eq!(
+        String::from_utf8_lossy(&o.stderr),
+        format!(
+            "qem: error: {}: cannot write: vertex 1 has coordinate 1e39, beyond the range of \
+             STL's float32 (about ±3.4e38); write PLY, OBJ or OFF instead\n",
+            output.display()
+        )
+    );
+    let names: Vec<_> = std::fs::read_dir(dir.path())
+        .expect("readable")
+        .filter_map(|e| e.ok().map(|e| e.file_name()))
+        .collect();
+    assert_eq!(names, vec![std::ffi::OsString::from("huge.obj")]);
+}
