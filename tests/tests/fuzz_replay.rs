@@ -3,33 +3,102 @@
 
 use std::path::{Path, PathBuf};
 
+use qem_tests::fuzz_checks::TARGETS;
+
 fn fuzz_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz")
 }
 
-/// Runs `check` on every file under `fuzz/corpus/TARGET` and `fuzz/regressions/TARGET`,
-/// and returns how many there were.
-fn replay(target: &str, check: fn(&[u8])) -> usize {
-    let mut count = 0;
-    for kind in ["corpus", "regressions"] {
-        let dir = fuzz_dir().join(kind).join(target);
-        let Ok(entries) = std::fs::read_dir(&dir) else {
-            continue;
-        };
-        let mut paths: Vec<PathBuf> = entries.filter_map(|e| Some(e.ok()?.path())).collect();
-        paths.sort();
-        for path in paths {
-            let data = std::fs::read(&path).expect("readable corpus file");
-            let outcome = std::panic::catch_unwind(|| check(&data));
-            assert!(outcome.is_ok(), "{target}: {} fails", path.display());
-            count += 1;
-        }
-    }
-    count
+/// The files of `fuzz/KIND/TARGET`, sorted; none when the directory is absent.
+fn files(kind: &str, target: &str) -> Vec<PathBuf> {
+    let Ok(entries) = std::fs::read_dir(fuzz_dir().join(kind).join(target)) else {
+        return Vec::new();
+    };
+    let mut paths: Vec<PathBuf> = entries.filter_map(|e| Some(e.ok()?.path())).collect();
+    paths.retain(|p| p.is_file());
+    paths.sort();
+    paths
 }
 
+/// Runs `check` on every file under `fuzz/corpus/TARGET` and `fuzz/regressions/TARGET`,
+/// and returns how many seed-corpus files there were. Every failing file is listed.
+fn replay(target: &str, check: fn(&[u8])) -> usize {
+    let mut failures = Vec::new();
+    for kind in ["corpus", "regressions"] {
+        for path in files(kind, target) {
+            let data = std::fs::read(&path).expect("readable corpus file");
+            if std::panic::catch_unwind(|| check(&data)).is_err() {
+                failures.push(path.display().to_string());
+            }
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{target}: failing files: {failures:#?}"
+    );
+    files("corpus", target).len()
+}
+
+/// One test per target, so a failure names it.
+macro_rules! replay_tests {
+    ($($name:ident: $target:literal,)*) => {
+        $(
+            #[test]
+            fn $name() {
+                let n = replay($target, check_of($target));
+                assert!(n > 0, "the {} seed corpus is missing", $target);
+            }
+        )*
+
+        /// Every target in `TARGETS` has a replay test above (and no other exists).
+        #[test]
+        fn every_target_is_replayed() {
+            let mut listed: Vec<&str> = TARGETS.iter().map(|(name, _)| *name).collect();
+            let mut tested = vec![$($target),*];
+            listed.sort_unstable();
+            tested.sort_unstable();
+            assert_eq!(listed, tested);
+        }
+    };
+}
+
+fn check_of(target: &str) -> fn(&[u8]) {
+    TARGETS
+        .iter()
+        .find(|(name, _)| *name == target)
+        .map(|(_, check)| *check)
+        .expect("a known target")
+}
+
+replay_tests! {
+    replay_quadric_solve: "quadric_solve",
+    replay_simplify_soup: "simplify_soup",
+    replay_store_ops: "store_ops",
+    replay_grid_pairs: "grid_pairs",
+    replay_read_obj: "read_obj",
+    replay_read_ply: "read_ply",
+    replay_read_stl: "read_stl",
+    replay_read_off: "read_off",
+}
+
+/// Every directory under `fuzz/corpus` and `fuzz/regressions` belongs to a target, so
+/// no reproducer is silently skipped; and every target has a `fuzz_targets/` file.
 #[test]
-fn replay_quadric_solve() {
-    let n = replay("quadric_solve", qem_tests::fuzz_checks::quadric_solve);
-    assert!(n > 0, "the quadric_solve seed corpus is missing");
+fn every_corpus_directory_has_a_target() {
+    for kind in ["corpus", "regressions"] {
+        let Ok(entries) = std::fs::read_dir(fuzz_dir().join(kind)) else {
+            continue;
+        };
+        for entry in entries.flatten() {
+            let name = entry.file_name().to_string_lossy().into_owned();
+            assert!(
+                TARGETS.iter().any(|(t, _)| *t == name),
+                "fuzz/{kind}/{name} has no target"
+            );
+        }
+    }
+    for (target, _) in TARGETS {
+        let source = fuzz_dir().join("fuzz_targets").join(format!("{target}.rs"));
+        assert!(source.is_file(), "{} is missing", source.display());
+    }
 }

@@ -7,7 +7,8 @@
 //! 1. weld bit-identical positions (`-0.0` and `+0.0` count as the same coordinate);
 //! 2. weld within a tolerance (off by default);
 //! 3. drop faces with a repeated index (after welding, which can create them);
-//! 4. drop zero-area faces ([`ZERO_AREA_FRACTION`]);
+//! 4. drop zero-area faces ([`ZERO_AREA_FRACTION`] of the squared diagonal, or a cross
+//!    product that underflows to exactly zero in world units);
 //! 5. drop duplicate faces: the same three vertices in any order. Back-to-back pairs
 //!    (the same triangle with opposite orientations) are duplicates by this rule: the
 //!    first occurrence is kept with its orientation, so a two-sided sheet becomes a
@@ -39,6 +40,21 @@ pub fn min_double_area(diagonal: f64) -> f64 {
     2.0 * ZERO_AREA_FRACTION * diagonal * diagonal
 }
 
+/// Whether the triangle's cross product is exactly zero in its own (world) units.
+///
+/// Why, beside the relative test in the normalised frame: at coordinates near 1e-300
+/// the area of a proper triangle underflows f64, so every reader of the output would
+/// see a zero-area face (and compute no normal), however well-shaped it is relative to
+/// the bounding box. Such faces count as zero-area.
+pub(crate) fn cross_underflows([a, b, c]: [[f64; 3]; 3]) -> bool {
+    let (a, b, c) = (
+        DVec3::from_array(a),
+        DVec3::from_array(b),
+        DVec3::from_array(c),
+    );
+    (b - a).cross(c - a) == DVec3::ZERO
+}
+
 /// Which passes run. Start from [`CleanOptions::DEFAULT`] and adjust with `with_*`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
@@ -51,7 +67,7 @@ pub struct CleanOptions {
     /// Drop faces that use a vertex twice. Default: `true`.
     pub drop_repeated_index: bool,
     /// Drop faces whose area is at most [`ZERO_AREA_FRACTION`] of the squared
-    /// bounding-box diagonal. Default: `true`.
+    /// bounding-box diagonal, or underflows to zero in world units. Default: `true`.
     pub drop_zero_area: bool,
     /// Drop faces with the same three vertices as an earlier face. Default: `true`.
     pub drop_duplicates: bool,
@@ -283,7 +299,10 @@ fn face_fate(
         let [a, b, c] = f.map(|i| frame.to_normalized(DVec3::from_array(positions[i as usize])));
         let double_area = (b - a).cross(c - a).length();
         // `!(x > min)` also drops NaN areas, which only overflow could produce.
-        if double_area.is_nan() || double_area <= min_double_area {
+        if double_area.is_nan()
+            || double_area <= min_double_area
+            || cross_underflows(f.map(|i| positions[i as usize]))
+        {
             return FaceFate::ZeroArea;
         }
     }

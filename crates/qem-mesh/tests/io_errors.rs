@@ -180,7 +180,7 @@ fn index_out_of_range_names_the_face() {
     let ply = b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n";
     assert_eq!(
         err(ply, Format::Ply),
-        "line 13: face 0 refers to vertex 3, but there are 3 vertices"
+        "line 13: face 0 refers to vertex 3, but there are only 3 vertices"
     );
 }
 

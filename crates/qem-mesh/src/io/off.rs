@@ -63,21 +63,21 @@ pub(crate) fn read(bytes: &[u8]) -> Result<IndexedMesh, ReadError> {
             "expected vertex, face and edge counts",
         ));
     }
-    let parse_count = |tok: &[u8], what: &str| -> Result<usize, ReadError> {
+    let parse_count = |tok: &[u8], what: &str, plural: &str| -> Result<usize, ReadError> {
         let n = text::parse_i64(tok).filter(|&n| n >= 0).ok_or_else(|| {
             ReadError::malformed(at(counts_line), format!("bad {what} count {}", show(tok)))
         })?;
         if n as u64 > MAX_ELEMENTS as u64 {
             return Err(ReadError::too_large(
                 at(counts_line),
-                format!("OFF header claims {what}:"),
+                format!("OFF header claims {plural}:"),
                 n as u64,
             ));
         }
         Ok(n as usize)
     };
-    let nv = parse_count(counts[0], "vertex")?;
-    let nf = parse_count(counts[1], "face")?;
+    let nv = parse_count(counts[0], "vertex", "vertices")?;
+    let nf = parse_count(counts[1], "face", "faces")?;
 
     let mut positions = Vec::with_capacity(capacity_for(nv, bytes.len(), 6));
     let mut last_line = counts_line;

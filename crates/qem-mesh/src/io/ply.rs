@@ -316,7 +316,7 @@ impl Builder {
                 .map_or("no".to_string(), |n| n.to_string());
             return Err(ReadError::malformed(
                 at,
-                format!("face {f} refers to vertex {i}, but there are {n} vertices"),
+                format!("face {f} refers to vertex {i}, but there are only {n} vertices"),
             ));
         }
         self.corners.push(i as u32);

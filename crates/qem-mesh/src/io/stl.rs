@@ -196,6 +196,27 @@ fn read_ascii(bytes: &[u8]) -> Result<IndexedMesh, ReadError> {
 }
 
 pub(crate) fn write(out: &mut impl Write, mesh: &IndexedMesh) -> std::io::Result<()> {
+    // float32 cannot hold coordinates beyond ±3.4e38: they would be written as infinity,
+    // a file no reader accepts. Refuse before writing anything.
+    if let Some((v, c)) = mesh
+        .triangles
+        .iter()
+        .flatten()
+        .filter_map(|&i| Some((i, mesh.positions.get(i as usize)?)))
+        .find_map(|(i, p)| {
+            p.iter()
+                .find(|c| (**c as f32).is_infinite())
+                .map(|c| (i, c))
+        })
+    {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!(
+                "vertex {v} has coordinate {c:e}, beyond the range of STL's float32 \
+                 (about ±3.4e38); write PLY, OBJ or OFF instead"
+            ),
+        ));
+    }
     let mut header = [b' '; 80];
     let tag = b"binary STL written by qem";
     header[..tag.len()].copy_from_slice(tag);

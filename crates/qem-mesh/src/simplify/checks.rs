@@ -2,6 +2,7 @@
 //! topology (the link condition) and locks. Cheapest first; none allocates.
 
 use super::engine::Engine;
+use crate::clean::cross_underflows;
 use crate::store::{EdgeClass, EdgeKey, VertexClass, VertexKey};
 use qem_core::DVec3;
 
@@ -78,6 +79,21 @@ impl Engine {
         Ok(())
     }
 
+    /// Whether a triangle with these world corners is (numerically) zero-area for the
+    /// loop: its double area in the normalised frame is at most the loop's bound (or
+    /// NaN), or its cross product underflows in world units. The same test decides which
+    /// contractions are refused and which faces are dropped at output, so a face the
+    /// loop kept is never dropped afterwards (the output's own frame can be larger than
+    /// the input's when a placement leaves the input's box, making a relative test there
+    /// stricter: a `simplify_soup` fuzz finding emptied the output that way).
+    pub(super) fn is_zero_area(&self, world_corners: [[f64; 3]; 3]) -> bool {
+        let [p0, p1, p2] = world_corners.map(|c| self.frame.to_normalized(DVec3::from_array(c)));
+        let squared = (p1 - p0).cross(p2 - p0).length_squared();
+        squared.is_nan()
+            || squared <= self.settings.min_double_area_squared
+            || (self.settings.world_may_underflow && cross_underflows(world_corners))
+    }
+
     /// Whether moving `a` and `b` to `world` would leave a surviving face of either
     /// with (numerically) zero area, turn its normal past the threshold, or make it a
     /// sliver worse than it was.
@@ -109,7 +125,17 @@ impl Engine {
                 // Squared lengths throughout: no square root unless the sliver test runs.
                 let new_squared = new_normal.length_squared();
                 // A NaN area (only from overflow) is refused too.
-                if new_squared.is_nan() || new_squared <= self.settings.min_double_area_squared {
+                if new_squared.is_nan()
+                    || new_squared <= self.settings.min_double_area_squared
+                    || (self.settings.world_may_underflow
+                        && cross_underflows(corners.map(|c| {
+                            if c == a || c == b {
+                                world.to_array()
+                            } else {
+                                self.store.position(c)
+                            }
+                        })))
+                {
                     verdict = Err(Rejection::Degenerate);
                     break 'vertices;
                 }

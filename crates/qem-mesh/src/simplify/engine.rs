@@ -85,6 +85,10 @@ impl Counters {
     }
 }
 
+/// Bounding-box diagonals (model units) below which world-unit cross products may
+/// underflow f64; see [`Settings::world_may_underflow`].
+const WORLD_UNDERFLOW_DIAGONAL: f64 = 1e-140;
+
 /// The options the loop reads, in the form it reads them.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Settings {
@@ -94,6 +98,10 @@ pub(super) struct Settings {
     /// The square of twice the area at or below which a face counts as zero-area
     /// (normalised units), to compare with a cross product's squared length.
     pub min_double_area_squared: f64,
+    /// Whether world coordinates are so small that a proper triangle's cross product
+    /// can underflow to zero in model units (see `clean::cross_underflows`); only then
+    /// does the fold-over check also test faces in world units.
+    pub world_may_underflow: bool,
     /// Cosine of the largest allowed normal turn; `None` when the check is off.
     pub min_normal_cos: Option<f64>,
     /// The sliver threshold; `None` when the check is off.
@@ -138,6 +146,9 @@ impl Engine {
             placement: options.placement,
             max_error_bound,
             min_double_area_squared: min_double_area(frame.normalized_diagonal()).powi(2),
+            // A cross product of edges of length L is about L²; f64 underflows below
+            // ~1e-308, so only a model smaller than ~1e-150 can be affected.
+            world_may_underflow: frame.world_diagonal() < WORLD_UNDERFLOW_DIAGONAL,
             min_normal_cos: (angle < 180.0).then(|| angle.to_radians().cos()),
             min_quality: (options.min_triangle_quality > 0.0)
                 .then_some(options.min_triangle_quality),

@@ -172,9 +172,21 @@ pub fn simplify_levels(
         timings.contract += clock.elapsed();
 
         let clock = Instant::now();
-        let raw = engine.store.to_mesh();
-        let final_clean = clean(&raw, &CleanOptions::OUTPUT);
+        let mut raw = engine.store.to_mesh();
+        // Zero area is judged in the loop's frame, not in the output's own (see
+        // `Engine::is_zero_area`): the loop refused every contraction that would make a
+        // face zero-area, so this drops only faces that came in so (cleaning passes off).
+        let before = raw.triangles.len();
+        raw.triangles
+            .retain(|t| !engine.is_zero_area(t.map(|i| raw.positions[i as usize])));
+        let zero_area_dropped = before - raw.triangles.len();
+        let final_clean = clean(&raw, &CleanOptions::OUTPUT.with_drop_zero_area(false));
         let out = final_clean.mesh;
+        if out.triangles.is_empty() {
+            return Err(SimplifyError::NothingLeftAfterCleaning {
+                triangles_in: mesh.triangle_count(),
+            });
+        }
         timings.compact = clock.elapsed();
 
         let counters = engine.counters;
@@ -193,8 +205,7 @@ pub fn simplify_levels(
             bbox_diagonal: frame.world_diagonal(),
             stop_reason,
             cleanup,
-            degenerate_faces_removed: final_clean.report.zero_area_faces
-                + final_clean.report.repeated_index_faces,
+            degenerate_faces_removed: zero_area_dropped + final_clean.report.repeated_index_faces,
             rejected_degenerate: counters.rejected_degenerate,
             rejected_flip: counters.rejected_flip,
             rejected_sliver: counters.rejected_sliver,

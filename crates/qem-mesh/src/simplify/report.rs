@@ -137,6 +137,9 @@ pub enum SimplifyError {
     /// The input failed validation.
     Input(InputError),
     /// Every triangle was degenerate or a duplicate: nothing is left to simplify.
+    /// (With [`CleanOptions::drop_zero_area`](crate::clean::CleanOptions::drop_zero_area)
+    /// turned off, zero-area faces enter the loop; if only such faces are left at the
+    /// end, this is the error too, since the output never has a zero-area face.)
     NothingLeftAfterCleaning {
         /// How many triangles the input had.
         triangles_in: usize,

@@ -1,6 +1,4 @@
-//! The property each fuzz target checks, as plain functions that panic on a violation.
-//!
-//! A panic is how libFuzzer learns of a bug, and how a replay test fails.
+//! `quadric_solve`: placement of arbitrary quadrics.
 
 use qem_core::{endpoint_placement, optimal_placement, DVec3, Quadric};
 

@@ -1,11 +1,13 @@
-//! Model-based test of `MeshStore`: random small meshes and random contraction
-//! sequences, applied both to the store and to a brute-force model (a plain triangle
-//! soup plus an explicit edge set, for wire edges). After every step every query of the
-//! store is compared with the same quantity recomputed from the model by brute force.
+//! The brute-force model of `MeshStore`: a plain triangle soup plus an explicit edge
+//! set (for wire edges), over input vertex ids. [`run`] applies a sequence of
+//! operations to both a store and the model and, after every step, compares every query
+//! of the store with the same quantity recomputed from the model by brute force.
+//!
+//! Used by the `store_model` property test and the `store_ops` fuzz target, so the two
+//! check the same thing.
 
 use std::collections::BTreeSet;
 
-use proptest::prelude::*;
 use qem_mesh::{ContractError, EdgeClass, IndexedMesh, MeshStore, VertexClass, VertexKey};
 
 /// The brute-force model, over input vertex ids.
@@ -467,103 +469,32 @@ fn check(s: &Subject, m: &Model) {
     assert_eq!(tris, m.sorted_faces(), "output triangles");
 }
 
+/// One step of a sequence applied by [`run`].
 #[derive(Clone, Debug)]
-enum Op {
-    /// Contract the `pick`-th edge (in sorted model order), into its smaller or larger id.
-    Edge { pick: usize, flip: bool },
-    /// Contract an arbitrary pair of input ids, which may be equal or no longer live.
-    Pair { a: usize, b: usize },
+pub enum Op {
+    /// Contract the `pick`-th edge (in sorted model order, modulo the edge count), into
+    /// its smaller or larger id.
+    Edge {
+        /// Which edge.
+        pick: usize,
+        /// Keep the larger id instead of the smaller.
+        flip: bool,
+    },
+    /// Contract an arbitrary pair of input ids (modulo the vertex count), which may be
+    /// equal or no longer live.
+    Pair {
+        /// The kept vertex.
+        a: usize,
+        /// The removed vertex.
+        b: usize,
+    },
 }
 
-fn op() -> impl Strategy<Value = Op> {
-    prop_oneof![
-        3 => (any::<usize>(), any::<bool>()).prop_map(|(pick, flip)| Op::Edge { pick, flip }),
-        2 => (0..12usize, 0..12usize).prop_map(|(a, b)| Op::Pair { a, b }),
-    ]
-}
-
-/// Random triangles over `n` vertex ids: mostly proper triangles in random orientation,
-/// some with repeated indices, plus copies of earlier triangles in any order.
-fn soup(n: usize) -> impl Strategy<Value = Vec<[u32; 3]>> {
-    let ids: Vec<u32> = (0..n as u32).collect();
-    let proper = (
-        proptest::sample::subsequence(ids, 3),
-        any::<bool>(),
-        0..3usize,
-    )
-        .prop_map(|(s, flip, rot)| {
-            let mut t = [s[0], s[1], s[2]];
-            if flip {
-                t.swap(1, 2);
-            }
-            t.rotate_left(rot);
-            t
-        });
-    let any_tri = [0..n as u32, 0..n as u32, 0..n as u32];
-    let tri = prop_oneof![6 => proper, 1 => any_tri];
-    let copies = prop::collection::vec((any::<usize>(), any::<bool>(), 0..3usize), 0..4);
-    (prop::collection::vec(tri, 1..14), copies).prop_map(|(mut tris, copies)| {
-        for (pick, flip, rot) in copies {
-            let mut t = tris[pick % tris.len()];
-            if flip {
-                t.swap(0, 1);
-            }
-            t.rotate_left(rot);
-            tris.push(t);
-        }
-        tris
-    })
-}
-
-/// A closed octahedron (every vertex interior) with some faces removed and some random
-/// triangles added, so that manifold neighbourhoods are common.
-fn octahedron_plus() -> impl Strategy<Value = Vec<[u32; 3]>> {
-    const OCTAHEDRON: [[u32; 3]; 8] = [
-        [0, 2, 4],
-        [2, 1, 4],
-        [1, 3, 4],
-        [3, 0, 4],
-        [2, 0, 5],
-        [1, 2, 5],
-        [3, 1, 5],
-        [0, 3, 5],
-    ];
-    (prop::collection::vec(any::<bool>(), 8), soup(8)).prop_map(|(drop, extra)| {
-        let mut tris: Vec<[u32; 3]> = OCTAHEDRON
-            .iter()
-            .zip(&drop)
-            // Keep most faces: drop one only where two flags in a row are set.
-            .enumerate()
-            .filter(|(i, (_, &d))| !(d && drop[(i + 1) % 8]))
-            .map(|(_, (&t, _))| t)
-            .collect();
-        tris.extend(extra.into_iter().take(3));
-        tris
-    })
-}
-
-/// Meshes over at most 12 vertex ids: a random soup, two random soups on disjoint ids
-/// (several components), or a perturbed octahedron.
-fn mesh() -> impl Strategy<Value = IndexedMesh> {
-    let one = (3..=10usize).prop_flat_map(|n| (Just(n), soup(n)));
-    let two = (3..=6usize, 3..=6usize).prop_flat_map(|(n, k)| {
-        (soup(n), soup(k)).prop_map(move |(mut first, second)| {
-            first.extend(second.iter().map(|t| t.map(|v| v + n as u32)));
-            (n + k, first)
-        })
-    });
-    let octa = octahedron_plus().prop_map(|t| (8usize, t));
-    prop_oneof![2 => one, 1 => two, 1 => octa].prop_map(|(n, tris)| {
-        let positions = (0..n)
-            .map(|i| [i as f64, (i % 3) as f64, (i / 3) as f64])
-            .collect();
-        IndexedMesh::new(positions, tris)
-    })
-}
-
-/// Runs `ops` on a fresh store and model, checking after every step; returns the final
-/// output so determinism can be checked.
-fn run(mesh: &IndexedMesh, ops: &[Op]) -> (IndexedMesh, Vec<VertexKey>) {
+/// Runs `ops` on a fresh store and model, checking after every step (panics on the first
+/// difference); returns the final output and live keys so determinism can be checked.
+///
+/// `mesh` must pass [`IndexedMesh::validate`].
+pub fn run(mesh: &IndexedMesh, ops: &[Op]) -> (IndexedMesh, Vec<VertexKey>) {
     let (store, keys) = MeshStore::from_mesh(mesh).expect("generated meshes are valid");
     let mut s = Subject { store, keys };
     let mut m = Model::new(mesh);
@@ -605,16 +536,4 @@ fn run(mesh: &IndexedMesh, ops: &[Op]) -> (IndexedMesh, Vec<VertexKey>) {
         check(&s, &m);
     }
     (s.store.to_mesh(), s.store.vertices().collect())
-}
-
-proptest! {
-    #![proptest_config(ProptestConfig { cases: 512, ..ProptestConfig::default() })]
-
-    #[test]
-    fn store_matches_brute_force_soup(mesh in mesh(), ops in prop::collection::vec(op(), 0..14)) {
-        let first = run(&mesh, &ops);
-        // Determinism: the same operations give the same keys and the same output.
-        let second = run(&mesh, &ops);
-        prop_assert_eq!(first, second);
-    }
 }

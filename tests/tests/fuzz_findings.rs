@@ -1,0 +1,131 @@
+//! Named regression tests for the fuzz findings recorded in FUZZING.md, stated as
+//! scenarios (the raw reproducers are replayed by `fuzz_replay.rs`).
+
+use qem_mesh::clean::CleanOptions;
+use qem_mesh::pairs::{virtual_pairs, GridOptions};
+use qem_mesh::simplify::{
+    simplify, Length, SimplifyError, SimplifyOptions, StopReason, Target, Weighting,
+};
+use qem_mesh::IndexedMesh;
+use qem_tests::mesh_checks::assert_valid_output;
+use qem_tests::pair_model::brute_force_pairs;
+
+/// simplify_soup finding 1 (`default_options_last_face_dropped_in_output_frame`): with
+/// unweighted quadrics and virtual pairs, placements land far outside the input's box
+/// (near (7, 8, −4) for an input inside [0, 3]×[0, 4]×[0, 2]). The last face then had a
+/// double area of about 1.8e-12: above the zero-area bound relative to the input's
+/// diagonal (5.8e-13), which the loop checks, but below the bound relative to the
+/// output's larger diagonal (2.3e-12), so the output clean dropped it and `simplify`
+/// returned an empty mesh. Zero area is now judged in the loop's frame at output too.
+#[test]
+fn a_placement_outside_the_input_box_never_empties_the_output() {
+    let mesh = IndexedMesh::new(
+        vec![
+            [0.0, 0.0, 0.0],
+            [0.0, 4.0, 2.0],
+            [3.0, 4.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [1.0, 2.0, 2.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 1.0, 1.0],
+            [1.0, 0.0, 0.0],
+        ],
+        vec![
+            [0, 1, 0],
+            [4, 2, 3],
+            [4, 2, 5],
+            [1, 7, 5],
+            [0, 0, 0],
+            [4, 0, 2],
+            [6, 0, 0],
+        ],
+    );
+    let options = SimplifyOptions::DEFAULT
+        .with_target(Target::Ratio(0.0))
+        .with_weighting(Weighting::Unweighted)
+        .with_pair_threshold(Length::DiagonalFraction(0.5))
+        .with_max_virtual_pairs_per_vertex(6)
+        .with_validate_each_contraction(true);
+    let out = simplify(&mesh, &options).expect("a valid input simplifies");
+    assert_valid_output(&out.mesh, mesh.triangle_count());
+    assert_eq!(out.mesh.triangle_count(), 1);
+    assert_eq!(out.report.degenerate_faces_removed, 0);
+    assert_eq!(out.report.stop_reason, StopReason::NoValidPair);
+}
+
+/// simplify_soup finding 2 (`zero_area_pass_off_*`): with the zero-area cleaning pass
+/// turned off, a triangle with two coincident (unwelded) corners entered the loop and
+/// came out as an empty mesh. It is now the documented error.
+#[test]
+fn zero_area_faces_let_in_are_the_documented_error_not_an_empty_mesh() {
+    let mesh = IndexedMesh::new(
+        vec![[1.0, 1.0, 1.0], [3e300, 1.0, 1.0], [1.0, 1.0, 1.0]],
+        vec![[1, 2, 0]],
+    );
+    let clean = CleanOptions::DEFAULT
+        .with_weld_exact(false)
+        .with_drop_zero_area(false);
+    let options = SimplifyOptions::DEFAULT
+        .with_target(Target::Ratio(0.0))
+        .with_clean(clean);
+    assert_eq!(
+        simplify(&mesh, &options).unwrap_err(),
+        SimplifyError::NothingLeftAfterCleaning { triangles_in: 1 }
+    );
+}
+
+/// grid_pairs finding (`saturated_cell_visited_twice`): cell coordinates of points
+/// beyond ±9.2e18 cells saturate at the ends of i64, and the neighbour offsets
+/// saturated too, so the edge cell was visited twice: its pairs were counted twice
+/// (`capped` 1 instead of 0 here) and offered twice to the nearest-k lists.
+#[test]
+fn points_beyond_the_cell_range_are_counted_once() {
+    let points = [
+        [0.0, -5.573184143441918e303, 5.30515525833e-312],
+        [0.0, -5.573184143441918e303, 5.30515525833e-312],
+        [0.0, 6.713868506e-315, 0.0],
+    ];
+    let options = GridOptions::new(0.5).with_max_per_vertex(3);
+    let found = virtual_pairs(&points, &options, |_, _| true);
+    assert_eq!(found.pairs, vec![(0, 1)]);
+    assert_eq!(found.capped, 0);
+}
+
+/// The same finding, where the doubled offers crowded a pair out: three coincident
+/// points in the saturated cell with k = 2 must give all three pairs (each point's two
+/// nearest are the other two), and gave only (0, 1) and (0, 2).
+#[test]
+fn coincident_points_beyond_the_cell_range_all_pair_up() {
+    let points = [[0.0, -1e300, 0.0]; 3];
+    let options = GridOptions::new(1.0).with_max_per_vertex(2);
+    let found = virtual_pairs(&points, &options, |_, _| true);
+    assert_eq!(found.pairs, vec![(0, 1), (0, 2), (1, 2)]);
+    assert_eq!(found, brute_force_pairs(&points, 1.0, 2, |_, _| true));
+}
+
+/// read_stl finding (`ascii_coordinate_beyond_float32*`): an ASCII STL coordinate such
+/// as 1e39 reads as f64, but binary STL stores float32, so writing it gave infinity: a
+/// file that no reader accepts. Writing STL now refuses such a coordinate.
+#[test]
+fn stl_output_refuses_coordinates_beyond_float32() {
+    let mesh = IndexedMesh::new(
+        vec![[0.0, 0.0, 0.0], [1e39, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        vec![[0, 1, 2]],
+    );
+    let mut bytes = Vec::new();
+    let err = qem_mesh::io::write_to(&mut bytes, &mesh, qem_mesh::io::Format::Stl)
+        .expect_err("1e39 does not fit in float32");
+    assert_eq!(err.kind(), std::io::ErrorKind::InvalidInput);
+    assert_eq!(
+        err.to_string(),
+        "vertex 1 has coordinate 1e39, beyond the range of STL's float32 (about ±3.4e38); \
+         write PLY, OBJ or OFF instead"
+    );
+    // The largest float32 still fits.
+    let edge = IndexedMesh::new(
+        vec![[0.0; 3], [f64::from(f32::MAX), 0.0, 0.0], [0.0, 1.0, 0.0]],
+        vec![[0, 1, 2]],
+    );
+    let mut bytes = Vec::new();
+    qem_mesh::io::write_to(&mut bytes, &edge, qem_mesh::io::Format::Stl).expect("fits");
+}
