@@ -5,26 +5,13 @@
 #![cfg(feature = "io")]
 #![allow(clippy::unwrap_used)]
 
+mod common;
+
+use common::corpus_dir;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use qem_mesh::io::{read_path, IoError, ReadErrorKind};
-
-fn corpus_dir() -> Option<PathBuf> {
-    let dir = match std::env::var_os("QEM_CORPUS") {
-        Some(d) => PathBuf::from(d),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/corpus"),
-    };
-    if dir.join("manifest.tsv").is_file() {
-        Some(dir)
-    } else {
-        eprintln!(
-            "SKIPPED: no corpus at {} (set QEM_CORPUS to the directory holding manifest.tsv)",
-            dir.display()
-        );
-        None
-    }
-}
 
 /// File name (without directories) → expected triangle count, for both the converted
 /// OBJ (`file`) and the original (`original_file`).

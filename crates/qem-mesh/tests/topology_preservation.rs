@@ -104,23 +104,7 @@ fn a_fin_is_left_alone() {
 #[cfg(feature = "io")]
 mod corpus {
     use super::*;
-    use std::path::{Path, PathBuf};
-
-    fn corpus_dir() -> Option<PathBuf> {
-        let dir = match std::env::var_os("QEM_CORPUS") {
-            Some(d) => PathBuf::from(d),
-            None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/corpus"),
-        };
-        if dir.join("manifest.tsv").is_file() {
-            Some(dir)
-        } else {
-            eprintln!(
-                "SKIPPED: no corpus at {} (set QEM_CORPUS to the directory holding manifest.tsv)",
-                dir.display()
-            );
-            None
-        }
-    }
+    use common::{corpus_dir, corpus_mesh};
 
     /// Closed, genus 4, open with holes, multipart with a non-manifold vertex, and an
     /// open non-manifold sheet.
@@ -137,16 +121,9 @@ mod corpus {
         let Some(dir) = corpus_dir() else { return };
         for name in MESHES {
             // The manifest names files under public/; the shared copy is flat.
-            let Some(path) = [dir.join(name), dir.join("public").join(name)]
-                .into_iter()
-                .find(|p| p.is_file())
-            else {
-                eprintln!("SKIPPED: {name} is not in {}", dir.display());
+            let Some(mesh) = corpus_mesh(&dir, name) else {
                 continue;
             };
-            let mesh = qem_mesh::io::read_path(&path)
-                .unwrap_or_else(|e| panic!("{name}: {e}"))
-                .mesh;
             assert_topology_kept(name, &mesh, &preserving(0.1));
         }
     }
@@ -159,16 +136,9 @@ mod corpus {
     fn closed_corpus_meshes_stay_closed_with_default_options() {
         let Some(dir) = corpus_dir() else { return };
         for name in ["c3d_nefertiti.obj", "npm_bunny.obj", "igl_fertility.obj"] {
-            let Some(path) = [dir.join(name), dir.join("public").join(name)]
-                .into_iter()
-                .find(|p| p.is_file())
-            else {
-                eprintln!("SKIPPED: {name} is not in {}", dir.display());
+            let Some(mesh) = corpus_mesh(&dir, name) else {
                 continue;
             };
-            let mesh = qem_mesh::io::read_path(&path)
-                .unwrap_or_else(|e| panic!("{name}: {e}"))
-                .mesh;
             assert_eq!(topology(&mesh).2, 0, "{name} is closed");
             for ratio in [0.5, 0.1] {
                 let options = SimplifyOptions::DEFAULT.with_target(Target::Ratio(ratio));

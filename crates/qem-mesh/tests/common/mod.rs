@@ -2,6 +2,40 @@
 #![allow(dead_code)]
 
 use qem_mesh::IndexedMesh;
+use std::path::{Path, PathBuf};
+
+/// The shared real-mesh corpus: `$QEM_CORPUS`, or `../shared/corpus` beside the
+/// workspace; `None` (with a SKIPPED message) when it is absent.
+pub fn corpus_dir() -> Option<PathBuf> {
+    let dir = match std::env::var_os("QEM_CORPUS") {
+        Some(d) => PathBuf::from(d),
+        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/corpus"),
+    };
+    if dir.join("manifest.tsv").is_file() {
+        Some(dir)
+    } else {
+        eprintln!(
+            "SKIPPED: no corpus at {} (set QEM_CORPUS to the directory holding manifest.tsv)",
+            dir.display()
+        );
+        None
+    }
+}
+
+/// The corpus mesh `name` (flat, or under `public/` as the manifest names it), loaded;
+/// `None` with a SKIPPED message when the file is absent.
+#[cfg(feature = "io")]
+pub fn corpus_mesh(dir: &Path, name: &str) -> Option<IndexedMesh> {
+    let Some(path) = [dir.join(name), dir.join("public").join(name)]
+        .into_iter()
+        .find(|p| p.is_file())
+    else {
+        eprintln!("SKIPPED: {name} is not in {}", dir.display());
+        return None;
+    };
+    let loaded = qem_mesh::io::read_path(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
+    Some(loaded.mesh)
+}
 
 /// A UV sphere of radius `r` centred at `c` with `rings` latitude bands and `segments`
 /// longitude bands: closed, 2·segments·(rings−1) triangles.
