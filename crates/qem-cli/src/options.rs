@@ -5,7 +5,7 @@
 use crate::failure::Failure;
 use clap::{Args, ValueEnum};
 use qem_mesh::simplify::{
-    BoundaryMode, Length, QuadricMode, SimplifyOptions, Target, VirtualPairs,
+    BoundaryMode, Length, QuadricMode, SimplifyOptions, Target, VirtualPairs, Weighting,
     DEFAULT_BOUNDARY_WEIGHT, DEFAULT_MAX_NORMAL_ANGLE, DEFAULT_MIN_TRIANGLE_QUALITY,
 };
 use std::path::{Path, PathBuf};
@@ -17,6 +17,15 @@ pub enum QuadricsFlag {
     Sum,
     /// The quadric of the union of the two plane sets (every plane counts once).
     Exact,
+}
+
+/// How face planes are weighted in the quadrics (`--weighting`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum WeightingFlag {
+    /// By triangle area (large faces count more than slivers).
+    Area,
+    /// Every face plane with weight 1.
+    Unweighted,
 }
 
 /// Which unconnected vertex pairs may merge (`--virtual-pairs`).
@@ -82,6 +91,9 @@ pub struct SimplifyFlags {
     /// Quadric of a contracted pair.
     #[arg(long, value_enum, default_value_t = QuadricsFlag::Sum)]
     pub quadrics: QuadricsFlag,
+    /// How face planes are weighted in the quadrics.
+    #[arg(long, value_enum, default_value_t = WeightingFlag::Area)]
+    pub weighting: WeightingFlag,
     /// A text file of vertex indices that must come out unmoved and present: one per
     /// line, 0-based, `#` starts a comment. Indices follow the vertex order as loaded:
     /// the file's order for PLY and OFF, three per facet for STL, and for OBJ the order
@@ -185,6 +197,10 @@ impl SimplifyFlags {
             .with_quadrics(match self.quadrics {
                 QuadricsFlag::Sum => QuadricMode::Sum,
                 QuadricsFlag::Exact => QuadricMode::Exact,
+            })
+            .with_weighting(match self.weighting {
+                WeightingFlag::Area => Weighting::Area,
+                WeightingFlag::Unweighted => Weighting::Unweighted,
             });
         Ok(match &self.lock {
             Some(path) => {

@@ -149,6 +149,7 @@ fn help_lists_the_quality_flags_with_defaults() {
         "--quadrics",
         "--lock <FILE>",
         "--virtual-pairs",
+        "--weighting",
     ] {
         assert!(help.contains(flag), "--help lacks {flag}");
     }
