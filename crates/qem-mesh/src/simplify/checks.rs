@@ -60,7 +60,9 @@ impl Engine {
         world: DVec3,
     ) -> Result<(), Rejection> {
         self.fold_over(a, b, world)?;
-        if ab.is_some() && self.would_merge_faces(a, b) {
+        // In topology mode the link condition below refuses these merges too (its edge
+        // half is the same test), so it is not run twice.
+        if ab.is_some() && !self.settings.preserve_topology && self.would_merge_faces(a, b) {
             return Err(Rejection::Merge);
         }
         if self.settings.keep_border_loops {

@@ -113,7 +113,9 @@ pub struct SimplifyReport {
     pub rejected_border: usize,
     /// Edge contractions refused because two faces `a x y` and `b x y` would have merged
     /// into one, which opens a hole in a closed surface (virtual pairs may merge faces:
-    /// joining parts is their purpose).
+    /// joining parts is their purpose). With
+    /// [`preserve_topology`](super::SimplifyOptions::preserve_topology) the link condition
+    /// refuses these first, and they count in [`rejected_topology`](Self::rejected_topology).
     pub rejected_merge: usize,
     /// Vertices of the cleaned input that were locked (by
     /// [`locked_vertices`](super::SimplifyOptions::locked_vertices) or by
