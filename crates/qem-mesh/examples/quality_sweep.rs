@@ -10,36 +10,11 @@ use qem_mesh::clean::{clean, CleanOptions};
 use qem_mesh::simplify::{simplify, BoundaryMode, QuadricMode, SimplifyOptions, Target};
 use qem_mesh::store::{EdgeClass, MeshStore};
 use qem_mesh::IndexedMesh;
-use std::collections::HashMap;
 use std::path::Path;
 
-/// Connected components of the graph of border edges (edges with one face).
+/// Border loops: connected groups of border edges, as `qem info` counts them.
 fn border_loops(mesh: &IndexedMesh) -> usize {
-    let Ok((store, _)) = MeshStore::from_mesh(mesh) else {
-        return 0;
-    };
-    let index: HashMap<_, usize> = store.vertices().enumerate().map(|(i, v)| (v, i)).collect();
-    let mut parent: Vec<usize> = (0..index.len()).collect();
-    fn find(parent: &mut [usize], mut i: usize) -> usize {
-        while parent[i] != i {
-            parent[i] = parent[parent[i]];
-            i = parent[i];
-        }
-        i
-    }
-    let mut on_border = vec![false; index.len()];
-    for e in store.edges() {
-        if store.classify_edge(e) == EdgeClass::Boundary {
-            let [a, b] = store.edge_vertices(e).map(|v| index[&v]);
-            on_border[a] = true;
-            on_border[b] = true;
-            let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
-            parent[ra] = rb;
-        }
-    }
-    (0..index.len())
-        .filter(|&i| on_border[i] && find(&mut parent, i) == i)
-        .count()
+    qem_mesh::inspect::inspect(mesh).map_or(0, |info| info.boundary_loops)
 }
 
 /// Total length of the border edges and total area.
