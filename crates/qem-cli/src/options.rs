@@ -83,6 +83,11 @@ pub struct SimplifyFlags {
     /// quality before; 0 turns the check off.
     #[arg(long, default_value_t = DEFAULT_MIN_TRIANGLE_QUALITY, value_parser = parse_unit_interval)]
     pub min_quality: f64,
+    /// Turn off the orientation check, which refuses a contraction that leaves a face
+    /// facing away from the input surface nearest to its centroid (faster; on by
+    /// default).
+    #[arg(long)]
+    pub no_orientation_check: bool,
     /// Keep the topology: only contractions that pass the link condition, none at
     /// non-manifold vertices or edges, no virtual pairs; Euler characteristic, parts and
     /// border loops are kept [default: off].
@@ -193,6 +198,7 @@ impl SimplifyFlags {
             })
             .with_max_normal_angle(self.max_normal_angle)
             .with_min_triangle_quality(self.min_quality)
+            .with_orientation_check(!self.no_orientation_check)
             .with_preserve_topology(self.preserve_topology)
             .with_quadrics(match self.quadrics {
                 QuadricsFlag::Sum => QuadricMode::Sum,

@@ -103,6 +103,7 @@ impl SimplifyJson {
                 ("locked", r.rejected_locked),
                 ("border", r.rejected_border),
                 ("merge", r.rejected_merge),
+                ("orientation", r.rejected_orientation),
             ]),
             locked_vertices: r.locked_vertices,
             faces_flipped: r.faces_flipped,

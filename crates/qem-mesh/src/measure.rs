@@ -514,6 +514,78 @@ impl TriangleBvh {
     }
 }
 
+impl TriangleBvh {
+    /// The triangles nearest to `p`: every triangle whose distance to `p` is at most
+    /// `factor` times the distance of the nearest one, plus `margin` (both distances,
+    /// not squares), as indices for [`corners`](Self::corners), in ascending index
+    /// order. `out` is cleared first; it is empty when there are no triangles.
+    ///
+    /// Why several: a point equally near two triangles (on their shared edge, say)
+    /// has no single nearest one, and a caller asking "which way does the surface face
+    /// here" must hear from all of them. `factor` below 1 counts as 1.
+    pub fn nearest_triangles(&self, p: [f64; 3], factor: f64, margin: f64, out: &mut Vec<u32>) {
+        out.clear();
+        if self.corners.is_empty() {
+            return;
+        }
+        let factor = factor.max(1.0);
+        // The bound a triangle must meet, from the best squared distance so far.
+        let bound = |best2: f64| {
+            let d = best2.sqrt() * factor + margin;
+            d * d * PRUNE_FACTOR + self.slack2
+        };
+        let mut best2 = f64::INFINITY;
+        let mut candidates: smallvec::SmallVec<[(u32, f64); 32]> = smallvec::SmallVec::new();
+        let mut stack: smallvec::SmallVec<[u32; 64]> = smallvec::SmallVec::new();
+        stack.push(0);
+        while let Some(n) = stack.pop() {
+            let node = &self.nodes[n as usize];
+            if node.bounds.distance2(p) > bound(best2) {
+                continue;
+            }
+            if node.count > 0 {
+                let start = node.first as usize;
+                for i in start..start + node.count as usize {
+                    let [a, b, c] = self.corners[i];
+                    let d2 = triangle_distance2(p, a, b, c);
+                    best2 = best2.min(d2);
+                    if d2 <= bound(best2) {
+                        candidates.push((i as u32, d2));
+                    }
+                }
+            } else {
+                let (l, r) = (node.first, node.first + 1);
+                let dl = self.nodes[l as usize].bounds.distance2(p);
+                let dr = self.nodes[r as usize].bounds.distance2(p);
+                if dl <= dr {
+                    stack.push(r);
+                    stack.push(l);
+                } else {
+                    stack.push(l);
+                    stack.push(r);
+                }
+            }
+        }
+        let limit = {
+            let d = best2.sqrt() * factor + margin;
+            d * d
+        };
+        out.extend(
+            candidates
+                .iter()
+                .filter(|&&(_, d2)| d2 <= limit)
+                .map(|&(i, _)| i),
+        );
+        out.sort_unstable();
+    }
+
+    /// The corners of triangle `i` (an index from
+    /// [`nearest_triangles`](Self::nearest_triangles)), in their input order.
+    pub fn corners(&self, i: u32) -> [[f64; 3]; 3] {
+        self.corners[i as usize]
+    }
+}
+
 /// The exact distance from `p` to the nearest triangle of `mesh`, by testing every
 /// triangle: the reference [`TriangleBvh::distance`] is checked against. `None` when the
 /// mesh has no triangle with valid indices.

@@ -23,6 +23,8 @@ pub(super) enum Rejection {
     Border,
     /// An edge contraction would merge two faces `a x y` and `b x y` into one.
     Merge,
+    /// A moved face would face away from the input surface nearest to it.
+    Orientation,
 }
 
 /// `4√3·area / (l₀² + l₁² + l₂²)` from twice the area (`double_area`): 1 for an
@@ -77,6 +79,10 @@ impl Engine {
         }
         if self.settings.any_locked && self.locked_vertex_would_vanish(a, b) {
             return Err(Rejection::Locked);
+        }
+        // Last: the only check that searches outside the neighbourhood.
+        if self.input_surface.is_some() && !self.faces_agree_with_input(a, b, world) {
+            return Err(Rejection::Orientation);
         }
         Ok(())
     }
@@ -166,6 +172,41 @@ impl Engine {
         }
         self.face_scratch = faces;
         verdict
+    }
+
+    /// Whether every face that contracting `b` into `a` at `world` moves faces the same
+    /// way as the input surface nearest to its new centroid (see
+    /// [`super::orientation`]). Faces on both `a` and `b` collapse and are not asked.
+    fn faces_agree_with_input(&mut self, a: VertexKey, b: VertexKey, world: DVec3) -> bool {
+        let Some(mut surface) = self.input_surface.take() else {
+            return true;
+        };
+        let moved = self.frame.to_normalized(world);
+        let mut faces = std::mem::take(&mut self.face_scratch);
+        let mut agree = true;
+        'vertices: for v in [a, b] {
+            self.store.faces_of_vertex(v, &mut faces);
+            for &f in &faces {
+                let corners = self.store.face_vertices(f);
+                if corners.contains(&a) && corners.contains(&b) {
+                    continue;
+                }
+                let new = corners.map(|c| {
+                    if c == a || c == b {
+                        moved
+                    } else {
+                        self.normalized_position(c)
+                    }
+                });
+                if !surface.agrees(new) {
+                    agree = false;
+                    break 'vertices;
+                }
+            }
+        }
+        self.face_scratch = faces;
+        self.input_surface = Some(surface);
+        agree
     }
 
     /// Whether contracting the edge `ab` would merge a face `a x y` with a face `b x y`

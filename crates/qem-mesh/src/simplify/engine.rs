@@ -6,6 +6,7 @@ use super::observer::{Contraction, Observer, Progress};
 use super::options::{
     BoundaryMode, PlacementMode, QuadricMode, SimplifyOptions, VirtualPairs, Weighting,
 };
+use super::orientation::InputSurface;
 use super::report::{SimplifyError, StopReason};
 use crate::clean::min_double_area;
 use crate::pairs::grid::{virtual_pairs, GridOptions};
@@ -67,6 +68,7 @@ pub(super) struct Counters {
     pub rejected_locked: usize,
     pub rejected_border: usize,
     pub rejected_merge: usize,
+    pub rejected_orientation: usize,
     pub locked_vertices: usize,
 }
 
@@ -80,6 +82,7 @@ impl Counters {
             Rejection::Locked => &mut self.rejected_locked,
             Rejection::Border => &mut self.rejected_border,
             Rejection::Merge => &mut self.rejected_merge,
+            Rejection::Orientation => &mut self.rejected_orientation,
         };
         *counter += 1;
     }
@@ -134,6 +137,8 @@ pub(super) struct Engine {
     scratch: Vec<(VertexKey, Option<EdgeKey>)>,
     /// Reused buffer of the faces around a vertex.
     pub face_scratch: Vec<FaceKey>,
+    /// The input surface for the orientation check; `None` when the check is off.
+    pub input_surface: Option<InputSurface>,
 }
 
 impl Engine {
@@ -168,6 +173,7 @@ impl Engine {
             counters: Counters::default(),
             scratch: Vec::new(),
             face_scratch: Vec::new(),
+            input_surface: None,
         }
     }
 

@@ -20,6 +20,7 @@ mod engine;
 mod exact;
 mod observer;
 mod options;
+mod orientation;
 mod report;
 
 pub use observer::{Contraction, NoObserver, Observer, Progress};
@@ -154,6 +155,9 @@ pub fn simplify_levels(
     let mut engine = Engine::new(store, frame, options);
     let clock = Instant::now();
     engine.initialise(&cleaned.mesh, &keys, &locked, options);
+    if options.orientation_check {
+        engine.input_surface = Some(orientation::InputSurface::new(&cleaned.mesh, &frame));
+    }
     timings.setup = clock.elapsed();
     observer.cleaned(&cleaned.mesh, &frame);
 
@@ -213,6 +217,7 @@ pub fn simplify_levels(
             rejected_locked: counters.rejected_locked,
             rejected_border: counters.rejected_border,
             rejected_merge: counters.rejected_merge,
+            rejected_orientation: counters.rejected_orientation,
             locked_vertices: counters.locked_vertices,
             faces_flipped: engine.flipped_faces(),
             timings,

@@ -159,6 +159,15 @@ pub struct SimplifyOptions {
     /// Counted in [`SimplifyReport::rejected_sliver`](super::SimplifyReport::rejected_sliver).
     /// Default: [`DEFAULT_MIN_TRIANGLE_QUALITY`].
     pub min_triangle_quality: f64,
+    /// Refuse a contraction that leaves a moved face facing away from the input surface
+    /// nearest to the face's centroid: every input triangle within 1.5 times the nearest
+    /// one's distance must have a positive dot product with the face's normal. Catches
+    /// what the fold-over check cannot: a large face over a crease or a thin part whose
+    /// centroid ends up nearest to the surface's other side. Costs one nearest-triangle
+    /// search per moved face, against an index built once over the cleaned input.
+    /// Counted in [`SimplifyReport::rejected_orientation`](super::SimplifyReport::rejected_orientation).
+    /// Default: `true`.
+    pub orientation_check: bool,
     /// Keep the topology: only contract edges that pass the link condition (with the
     /// border extension), never at non-manifold vertices or edges, and no virtual
     /// pairs. The Euler characteristic, the number of components and the number of
@@ -220,6 +229,7 @@ impl SimplifyOptions {
         boundary: BoundaryMode::Planes(DEFAULT_BOUNDARY_WEIGHT),
         max_normal_angle: DEFAULT_MAX_NORMAL_ANGLE,
         min_triangle_quality: DEFAULT_MIN_TRIANGLE_QUALITY,
+        orientation_check: true,
         preserve_topology: false,
         locked_vertices: Vec::new(),
         clean: CleanOptions::DEFAULT,
@@ -289,6 +299,12 @@ impl SimplifyOptions {
     /// Sets [`min_triangle_quality`](Self::min_triangle_quality).
     pub fn with_min_triangle_quality(mut self, quality: f64) -> Self {
         self.min_triangle_quality = quality;
+        self
+    }
+
+    /// Sets [`orientation_check`](Self::orientation_check).
+    pub fn with_orientation_check(mut self, on: bool) -> Self {
+        self.orientation_check = on;
         self
     }
 

@@ -117,6 +117,10 @@ pub struct SimplifyReport {
     /// [`preserve_topology`](super::SimplifyOptions::preserve_topology) the link condition
     /// refuses these first, and they count in [`rejected_topology`](Self::rejected_topology).
     pub rejected_merge: usize,
+    /// Contractions refused by the orientation check
+    /// ([`orientation_check`](super::SimplifyOptions::orientation_check)): a moved face
+    /// would have faced away from the input surface nearest to it.
+    pub rejected_orientation: usize,
     /// Vertices of the cleaned input that were locked (by
     /// [`locked_vertices`](super::SimplifyOptions::locked_vertices) or by
     /// [`BoundaryMode::Locked`](super::BoundaryMode::Locked)).
