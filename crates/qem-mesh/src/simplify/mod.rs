@@ -154,10 +154,17 @@ pub fn simplify_levels(
     let frame = Frame::from_points(cleaned.mesh.positions.iter().map(|p| DVec3::from_array(*p)));
     let mut engine = Engine::new(store, frame, options);
     let clock = Instant::now();
-    engine.initialise(&cleaned.mesh, &keys, &locked, options);
-    if options.orientation_check {
-        engine.input_surface = Some(orientation::InputSurface::new(&cleaned.mesh, &frame));
-    }
+    // The orientation check's index is independent of the quadrics and queue: built on
+    // the other core meanwhile (deterministic either way).
+    let ((), input_surface) = rayon::join(
+        || engine.initialise(&cleaned.mesh, &keys, &locked, options),
+        || {
+            options
+                .orientation_check
+                .then(|| orientation::InputSurface::new(&cleaned.mesh, &frame))
+        },
+    );
+    engine.input_surface = input_surface;
     timings.setup = clock.elapsed();
     observer.cleaned(&cleaned.mesh, &frame);
 
