@@ -566,14 +566,13 @@ impl TriangleBvh {
                 }
             }
         }
-        let limit = {
-            let d = best2.sqrt() * factor + margin;
-            d * d
-        };
+        // Compared as distances, not squares: squaring the limit back can round it
+        // below `best2` itself and drop the nearest triangle.
+        let limit = best2.sqrt() * factor + margin;
         out.extend(
             candidates
                 .iter()
-                .filter(|&&(_, d2)| d2 <= limit)
+                .filter(|&&(_, d2)| d2.sqrt() <= limit)
                 .map(|&(i, _)| i),
         );
         out.sort_unstable();
