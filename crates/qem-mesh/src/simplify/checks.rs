@@ -53,13 +53,16 @@ fn turned_past(old: DVec3, new: DVec3, new_squared: f64, min_cos: f64) -> bool {
 }
 
 impl Engine {
-    /// Every check of contracting `b` into `a` at `world` (`ab` is their edge, if any).
+    /// Every check of contracting `b` into `a` at `world` (`ab` is their edge, if any);
+    /// the orientation check only when `orientation` is true (it is waived for a pair
+    /// queued again at a penalty).
     pub(super) fn check(
         &mut self,
         a: VertexKey,
         b: VertexKey,
         ab: Option<EdgeKey>,
         world: DVec3,
+        orientation: bool,
     ) -> Result<(), Rejection> {
         self.fold_over(a, b, world)?;
         // In topology mode the link condition below refuses these merges too (its edge
@@ -81,7 +84,8 @@ impl Engine {
             return Err(Rejection::Locked);
         }
         // Last: the only check that searches outside the neighbourhood.
-        if self.input_surface.is_some() && !self.faces_agree_with_input(a, b, world) {
+        if orientation && self.input_surface.is_some() && !self.faces_agree_with_input(a, b, world)
+        {
             return Err(Rejection::Orientation);
         }
         Ok(())

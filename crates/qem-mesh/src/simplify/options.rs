@@ -165,7 +165,10 @@ pub struct SimplifyOptions {
     /// what the fold-over check cannot: a large face over a crease or a thin part whose
     /// centroid ends up nearest to the surface's other side. Costs one nearest-triangle
     /// search per moved face, against an index built once over the cleaned input.
-    /// Counted in [`SimplifyReport::rejected_orientation`](super::SimplifyReport::rejected_orientation).
+    /// A refused pair is not dropped but queued again at 32 times its cost, so it is
+    /// taken only when every alternative costs more: at extreme ratios refusing for good
+    /// would force far costlier contractions elsewhere. Counted in
+    /// [`SimplifyReport::rejected_orientation`](super::SimplifyReport::rejected_orientation).
     /// Default: `true`.
     pub orientation_check: bool,
     /// Keep the topology: only contract edges that pass the link condition (with the

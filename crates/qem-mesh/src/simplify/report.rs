@@ -119,7 +119,9 @@ pub struct SimplifyReport {
     pub rejected_merge: usize,
     /// Contractions refused by the orientation check
     /// ([`orientation_check`](super::SimplifyOptions::orientation_check)): a moved face
-    /// would have faced away from the input surface nearest to it.
+    /// would have faced away from the input surface nearest to it. Such a pair is
+    /// queued again at a penalty and may be contracted later, when everything else
+    /// costs more; each refusal is counted.
     pub rejected_orientation: usize,
     /// Vertices of the cleaned input that were locked (by
     /// [`locked_vertices`](super::SimplifyOptions::locked_vertices) or by
