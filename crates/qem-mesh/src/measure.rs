@@ -515,18 +515,31 @@ impl TriangleBvh {
 }
 
 impl TriangleBvh {
-    /// The triangles nearest to `p`: every triangle whose distance to `p` is at most
-    /// `factor` times the distance of the nearest one, plus `margin` (both distances,
-    /// not squares), as indices for [`corners`](Self::corners), in ascending index
-    /// order. `out` is cleared first; it is empty when there are no triangles.
+    /// The triangles nearest to `p`: of the triangles whose distance to `p` is at most
+    /// `factor` times the distance of the nearest one plus `margin` (both distances, not
+    /// squares), the `max_count` nearest (by squared distance, then by index), as indices
+    /// for [`corners`](Self::corners) in ascending index order. `out` is cleared first;
+    /// it is empty when there are no triangles (or `max_count` is 0). Returns the
+    /// nearest triangle (the lowest index among those at the least squared distance),
+    /// `None` when there are no triangles.
     ///
-    /// Why several: a point equally near two triangles (on their shared edge, say)
-    /// has no single nearest one, and a caller asking "which way does the surface face
-    /// here" must hear from all of them. `factor` below 1 counts as 1.
-    pub fn nearest_triangles(&self, p: [f64; 3], factor: f64, margin: f64, out: &mut Vec<u32>) {
+    /// Why several: a point equally near two triangles (on their shared edge, say) has
+    /// no single nearest one, and a caller asking "which way does the surface face here"
+    /// must hear from all of them. Why a count: above a finely cut region the ball can
+    /// hold hundreds of triangles, and the count keeps the search's cost bounded (the
+    /// pruning radius shrinks to the `max_count`-th distance). `factor` below 1 counts
+    /// as 1.
+    pub fn nearest_triangles(
+        &self,
+        p: [f64; 3],
+        factor: f64,
+        margin: f64,
+        max_count: usize,
+        out: &mut Vec<u32>,
+    ) -> Option<u32> {
         out.clear();
         if self.corners.is_empty() {
-            return;
+            return None;
         }
         let factor = factor.max(1.0);
         // The bound a triangle must meet, from the best squared distance so far.
@@ -535,12 +548,23 @@ impl TriangleBvh {
             d * d * PRUNE_FACTOR + self.slack2
         };
         let mut best2 = f64::INFINITY;
-        let mut candidates: smallvec::SmallVec<[(u32, f64); 32]> = smallvec::SmallVec::new();
+        // The nearest found so far, sorted by (squared distance, index), at most
+        // `max_count` long (and at least 1, to know the nearest).
+        let keep = max_count.max(1);
+        let mut candidates: smallvec::SmallVec<[(f64, u32); 16]> = smallvec::SmallVec::new();
+        let prune = |best2: f64, candidates: &[(f64, u32)]| {
+            let b = bound(best2);
+            if candidates.len() == keep {
+                b.min(candidates[keep - 1].0 * PRUNE_FACTOR + self.slack2)
+            } else {
+                b
+            }
+        };
         let mut stack: smallvec::SmallVec<[u32; 64]> = smallvec::SmallVec::new();
         stack.push(0);
         while let Some(n) = stack.pop() {
             let node = &self.nodes[n as usize];
-            if node.bounds.distance2(p) > bound(best2) {
+            if node.bounds.distance2(p) > prune(best2, &candidates) {
                 continue;
             }
             if node.count > 0 {
@@ -549,8 +573,15 @@ impl TriangleBvh {
                     let [a, b, c] = self.corners[i];
                     let d2 = triangle_distance2(p, a, b, c);
                     best2 = best2.min(d2);
-                    if d2 <= bound(best2) {
-                        candidates.push((i as u32, d2));
+                    if d2 > bound(best2) {
+                        continue;
+                    }
+                    let entry = (d2, i as u32);
+                    let at = candidates
+                        .partition_point(|x| x.0.total_cmp(&d2).then(x.1.cmp(&entry.1)).is_lt());
+                    if at < keep {
+                        candidates.insert(at, entry);
+                        candidates.truncate(keep);
                     }
                 }
             } else {
@@ -572,16 +603,140 @@ impl TriangleBvh {
         out.extend(
             candidates
                 .iter()
-                .filter(|&&(_, d2)| d2.sqrt() <= limit)
-                .map(|&(i, _)| i),
+                .take(max_count)
+                .filter(|&&(d2, _)| d2.sqrt() <= limit)
+                .map(|&(_, i)| i),
         );
         out.sort_unstable();
+        candidates.first().map(|&(_, i)| i)
+    }
+
+    /// The squared distance from `p` to triangle `i` (an index for
+    /// [`corners`](Self::corners)); `None` when `i` is out of range.
+    pub fn distance_squared_to(&self, p: [f64; 3], i: u32) -> Option<f64> {
+        let [a, b, c] = self.corners.get(i as usize)?;
+        Some(triangle_distance2(p, *a, *b, *c))
+    }
+
+    /// Per-node bounds of the triangles' unit normals, for
+    /// [`any_facing_away`](Self::any_facing_away). Built bottom-up in O(n).
+    pub fn normal_bounds(&self) -> NormalBounds {
+        let mut boxes = vec![Aabb::EMPTY; self.nodes.len()];
+        // Children always have higher indices than their parent (see `new`), so a
+        // reverse sweep sees both children before the parent.
+        for n in (0..self.nodes.len()).rev() {
+            let node = self.nodes[n];
+            let mut bounds = Aabb::EMPTY;
+            if node.count > 0 {
+                let start = node.first as usize;
+                for [a, b, c] in &self.corners[start..start + node.count as usize] {
+                    let normal = cross(sub(*b, *a), sub(*c, *a));
+                    let length = length(normal);
+                    // A zero-area triangle has no direction and no say.
+                    if length > 0.0 && length.is_finite() {
+                        bounds.grow(normal.map(|x| x / length));
+                    }
+                }
+            } else {
+                for child in [node.first as usize, node.first as usize + 1] {
+                    bounds.grow(boxes[child].lo);
+                    bounds.grow(boxes[child].hi);
+                }
+            }
+            boxes[n] = bounds;
+        }
+        NormalBounds { boxes }
+    }
+
+    /// Whether some triangle within `radius` of `p` faces away from `normal`: its normal
+    /// has a dot product ≤ 0 with `normal` (zero-area triangles excepted). A subtree
+    /// whose normals all face the same way as `normal` (by `bounds`, from
+    /// [`normal_bounds`](Self::normal_bounds) of this index) is skipped whole, so on a
+    /// smooth patch the search ends well above the leaves.
+    ///
+    /// May also answer true for a triangle a rounding error beyond `radius` (the box
+    /// tests are widened, never narrowed); never answers false wrongly.
+    pub fn any_facing_away(
+        &self,
+        bounds: &NormalBounds,
+        p: [f64; 3],
+        radius: f64,
+        normal: [f64; 3],
+    ) -> bool {
+        if self.corners.is_empty() || bounds.boxes.len() != self.nodes.len() {
+            return !self.corners.is_empty();
+        }
+        let radius2 = radius * radius * PRUNE_FACTOR + self.slack2;
+        let mut stack: smallvec::SmallVec<[u32; 64]> = smallvec::SmallVec::new();
+        stack.push(0);
+        while let Some(n) = stack.pop() {
+            let node = &self.nodes[n as usize];
+            if node.bounds.distance2(p) > radius2 || bounds.all_face(n, normal) {
+                continue;
+            }
+            if node.count > 0 {
+                let start = node.first as usize;
+                for [a, b, c] in &self.corners[start..start + node.count as usize] {
+                    let t = cross(sub(*b, *a), sub(*c, *a));
+                    if dot(t, normal) <= 0.0
+                        && t != [0.0; 3]
+                        && triangle_distance2(p, *a, *b, *c) <= radius2
+                    {
+                        return true;
+                    }
+                }
+            } else {
+                stack.push(node.first);
+                stack.push(node.first + 1);
+            }
+        }
+        false
     }
 
     /// The corners of triangle `i` (an index from
     /// [`nearest_triangles`](Self::nearest_triangles)), in their input order.
     pub fn corners(&self, i: u32) -> [[f64; 3]; 3] {
         self.corners[i as usize]
+    }
+}
+
+/// Bounds of the unit normals under each node of a [`TriangleBvh`], from
+/// [`TriangleBvh::normal_bounds`].
+#[derive(Clone, Debug)]
+pub struct NormalBounds {
+    boxes: Vec<Aabb>,
+}
+
+/// How far above zero the lower bound of a dot product must be before a whole subtree
+/// counts as facing the same way: far above the rounding of unit normals (about 1e-16),
+/// so that rounding never hides a triangle at right angles.
+const FACING_MARGIN: f64 = 1e-9;
+
+impl NormalBounds {
+    /// Whether every unit normal under node `n` has a positive dot product with
+    /// `normal`, by the least value of `x·normal` over the node's box of normals (a
+    /// lower bound, since the unit normals lie in the box). An empty box (only
+    /// zero-area triangles) faces every way.
+    fn all_face(&self, n: u32, normal: [f64; 3]) -> bool {
+        let b = &self.boxes[n as usize];
+        if b.lo[0] > b.hi[0] {
+            return true;
+        }
+        let length = length(normal);
+        if !(length > 0.0) || !length.is_finite() {
+            return false;
+        }
+        let least: f64 = (0..3)
+            .map(|k| {
+                let u = normal[k] / length;
+                if u >= 0.0 {
+                    u * b.lo[k]
+                } else {
+                    u * b.hi[k]
+                }
+            })
+            .sum();
+        least > FACING_MARGIN
     }
 }
 

@@ -295,33 +295,39 @@ proptest! {
     }
 
     /// `nearest_triangles` returns exactly the triangles a brute-force pass over the
-    /// mesh finds within `factor` times the nearest distance plus `margin`; the pruning
-    /// margin of the index may add triangles at the bound itself but never lose one.
+    /// mesh finds: of those within `factor` times the nearest distance plus `margin`, the
+    /// `max_count` nearest (by squared distance, then index); and the nearest one.
     #[test]
     fn nearest_triangles_are_those_brute_force_finds_within_the_bound(
         mesh in soup(),
         queries in proptest::collection::vec(point(), 1..20),
         factor in 1.0f64..2.0,
         margin in prop_oneof![Just(0.0), 0.0f64..0.5],
+        max_count in prop_oneof![Just(usize::MAX), 0usize..10],
     ) {
         let bvh = TriangleBvh::new(&mesh);
         let mut near = Vec::new();
         for p in queries {
-            bvh.nearest_triangles(p, factor, margin, &mut near);
-            let distance = |i: u32| {
+            let nearest = bvh.nearest_triangles(p, factor, margin, max_count, &mut near);
+            let squared = |i: u32| {
                 let [a, b, c] = bvh.corners(i);
                 let q = closest_point_on_triangle(p, a, b, c);
-                (0..3).map(|k| (q[k] - p[k]).powi(2)).sum::<f64>().sqrt()
+                (0..3).map(|k| (q[k] - p[k]).powi(2)).sum::<f64>()
             };
-            let all: Vec<f64> = (0..mesh.triangles.len() as u32).map(distance).collect();
-            let nearest = all.iter().copied().fold(f64::INFINITY, f64::min);
-            prop_assert_eq!(Some(nearest), bvh.distance(p));
-            let limit = nearest * factor + margin;
-            let expected: Vec<u32> = (0..all.len() as u32)
-                .filter(|&i| all[i as usize] <= limit)
+            let mut all: Vec<(f64, u32)> =
+                (0..mesh.triangles.len() as u32).map(|i| (squared(i), i)).collect();
+            all.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+            prop_assert_eq!(Some(all[0].0.sqrt()), bvh.distance(p));
+            prop_assert_eq!(nearest, Some(all[0].1));
+            let limit = all[0].0.sqrt() * factor + margin;
+            let mut expected: Vec<u32> = all
+                .iter()
+                .filter(|&&(d2, _)| d2.sqrt() <= limit)
+                .take(max_count)
+                .map(|&(_, i)| i)
                 .collect();
+            expected.sort_unstable();
             prop_assert_eq!(&near, &expected);
-            prop_assert!(near.windows(2).all(|w| w[0] < w[1]));
         }
     }
 

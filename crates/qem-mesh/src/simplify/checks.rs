@@ -188,6 +188,8 @@ impl Engine {
         let moved = self.frame.to_normalized(world);
         let mut faces = std::mem::take(&mut self.face_scratch);
         let mut agree = true;
+        // A face seen for the first time borrows the hint of the face checked before it.
+        let mut neighbour_hint = None;
         'vertices: for v in [a, b] {
             self.store.faces_of_vertex(v, &mut faces);
             for &f in &faces {
@@ -202,7 +204,7 @@ impl Engine {
                         self.normalized_position(c)
                     }
                 });
-                if !surface.agrees(new) {
+                if !surface.agrees(f, new, &mut neighbour_hint) {
                     agree = false;
                     break 'vertices;
                 }
