@@ -50,12 +50,40 @@ pub enum PlacementMode {
 }
 
 /// How face planes are weighted in the vertex quadrics.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Weighting {
     /// By triangle area (large faces count more than slivers).
     Area,
     /// Every face plane with weight 1.
     Unweighted,
+    /// A blend: face weight `area + s · Ā`, where `Ā` is the mean area of the cleaned
+    /// input's faces. `s = 0` is [`Area`](Self::Area) (bit for bit); as `s` grows the
+    /// weights tend to equal, i.e. to [`Unweighted`](Self::Unweighted) up to a common
+    /// factor, which changes no decision (an infinite `s` is `Unweighted`). A negative
+    /// or NaN `s` counts as 0.
+    ///
+    /// Why this form: area weights let a large flat region outvote the small faces of
+    /// a sharp feature (tips get shaved: larger Hausdorff distance), unit weights let
+    /// slivers and tiny faces count as much as large ones (larger mean error); adding a
+    /// constant lifts the small faces to at least `s · Ā` while large faces still count
+    /// by area. Using the *mean* area keeps it scale-free: scaling the mesh scales every
+    /// weight by the same factor.
+    Mixed(f64),
+}
+
+impl Weighting {
+    /// The constant added to every face's area, `s · Ā` (0 for [`Area`](Self::Area)),
+    /// or `None` for unit weights ([`Unweighted`](Self::Unweighted), or an infinite
+    /// `s`). `mean_area` is `Ā`.
+    pub(crate) fn area_offset(self, mean_area: f64) -> Option<f64> {
+        match self {
+            Weighting::Area => Some(0.0),
+            Weighting::Unweighted => None,
+            Weighting::Mixed(s) if s == f64::INFINITY => None,
+            Weighting::Mixed(s) if s > 0.0 => Some(s * mean_area),
+            Weighting::Mixed(_) => Some(0.0),
+        }
+    }
 }
 
 /// What happens at the border of an open surface (edges with exactly one face).
@@ -67,8 +95,10 @@ pub enum BoundaryMode {
     /// Garland–Heckbert's constraint planes (§6.2 of the paper): through each border
     /// edge, perpendicular to its face, added to the quadrics of both ends with this
     /// weight. The plane's weight is `w · |edge|²` with [`Weighting::Area`] (an area,
-    /// like the face planes it competes with, so the weight is scale-free) and `w` with
-    /// [`Weighting::Unweighted`]. Moving a border vertex off its border line then costs
+    /// like the face planes it competes with, so the weight is scale-free), `w` with
+    /// [`Weighting::Unweighted`], and `w · (|edge|² + s · Ā)` with
+    /// [`Weighting::Mixed`]`(s)` (the same offset as the faces get, so the ratio of
+    /// border to face weight stays between the two other modes'). Moving a border vertex off its border line then costs
     /// about `w` times as much as moving it the same distance off its faces' plane.
     ///
     /// Also the *loop rule*: an edge whose two ends are on a border must be a border
