@@ -21,7 +21,7 @@ pub enum QuadricsFlag {
 
 /// The default of `--weighting`, as written on the command line; a unit test checks
 /// that it parses to the library's default.
-pub const DEFAULT_WEIGHTING_FLAG: &str = "area";
+pub const DEFAULT_WEIGHTING_FLAG: &str = "mixed:0.75";
 
 /// Which unconnected vertex pairs may merge (`--virtual-pairs`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -84,7 +84,7 @@ pub struct SimplifyFlags {
     #[arg(long)]
     pub preserve_topology: bool,
     /// Quadric of a contracted pair.
-    #[arg(long, value_enum, default_value_t = QuadricsFlag::Sum)]
+    #[arg(long, value_enum, default_value_t = QuadricsFlag::Exact)]
     pub quadrics: QuadricsFlag,
     /// How face planes are weighted in the quadrics: `area` (by triangle area),
     /// `unweighted` (weight 1 each) or `mixed:S` (area + S × the mean face area; S = 0
@@ -254,5 +254,24 @@ mod tests {
             parse_weighting(DEFAULT_WEIGHTING_FLAG),
             Ok(SimplifyOptions::DEFAULT.weighting)
         );
+        assert_eq!(
+            parse_weighting(DEFAULT_WEIGHTING_FLAG),
+            Ok(Weighting::Mixed(qem_mesh::simplify::DEFAULT_WEIGHTING_MIX))
+        );
+    }
+
+    #[test]
+    fn default_flags_give_the_library_defaults() {
+        use clap::Parser;
+        #[derive(Parser)]
+        struct Cli {
+            #[command(flatten)]
+            flags: SimplifyFlags,
+        }
+        let options = Cli::parse_from(["qem"])
+            .flags
+            .options()
+            .expect("no lock file");
+        assert_eq!(options, SimplifyOptions::DEFAULT);
     }
 }
