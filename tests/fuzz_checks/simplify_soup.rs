@@ -62,10 +62,12 @@ fn decode(data: &[u8]) -> (IndexedMesh, SimplifyOptions) {
         } else {
             PlacementMode::Optimal
         })
-        .with_weighting(if flag(1) {
-            Weighting::Unweighted
-        } else {
-            Weighting::Area
+        .with_weighting(match (flag(1), cap % 2) {
+            (false, _) => Weighting::Area,
+            (true, 0) => Weighting::Unweighted,
+            // No flag bit is free: the blend takes an odd virtual-pair cap as its
+            // switch and the pair threshold's byte as its mix (0 to 8).
+            (true, _) => Weighting::Mixed(threshold * 8.0),
         })
         .with_max_error(flag(2).then_some(length(max_error)))
         .with_pair_threshold(length(threshold))

@@ -19,14 +19,9 @@ pub enum QuadricsFlag {
     Exact,
 }
 
-/// How face planes are weighted in the quadrics (`--weighting`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum WeightingFlag {
-    /// By triangle area (large faces count more than slivers).
-    Area,
-    /// Every face plane with weight 1.
-    Unweighted,
-}
+/// The default of `--weighting`, as written on the command line; a unit test checks
+/// that it parses to the library's default.
+pub const DEFAULT_WEIGHTING_FLAG: &str = "mixed:0.75";
 
 /// Which unconnected vertex pairs may merge (`--virtual-pairs`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -94,11 +89,14 @@ pub struct SimplifyFlags {
     #[arg(long)]
     pub preserve_topology: bool,
     /// Quadric of a contracted pair.
-    #[arg(long, value_enum, default_value_t = QuadricsFlag::Sum)]
+    #[arg(long, value_enum, default_value_t = QuadricsFlag::Exact)]
     pub quadrics: QuadricsFlag,
-    /// How face planes are weighted in the quadrics.
-    #[arg(long, value_enum, default_value_t = WeightingFlag::Area)]
-    pub weighting: WeightingFlag,
+    /// How face planes are weighted in the quadrics: `area` (by triangle area),
+    /// `unweighted` (weight 1 each) or `mixed:S` (area + S × the mean face area; S = 0
+    /// is `area`, large S tends to `unweighted`).
+    #[arg(long, value_name = "area|unweighted|mixed:S", value_parser = parse_weighting,
+          default_value = DEFAULT_WEIGHTING_FLAG)]
+    pub weighting: Weighting,
     /// A text file of vertex indices that must come out unmoved and present: one per
     /// line, 0-based, `#` starts a comment. Indices follow the vertex order as loaded:
     /// the file's order for PLY and OFF, three per facet for STL, and for OBJ the order
@@ -128,6 +126,20 @@ fn parse_non_negative(s: &str) -> Result<f64, String> {
         Ok(v)
     } else {
         Err(format!("{v} must be a finite number ≥ 0"))
+    }
+}
+
+/// Parses `--weighting`: `area`, `unweighted` or `mixed:S` with S a finite number ≥ 0.
+pub fn parse_weighting(s: &str) -> Result<Weighting, String> {
+    match s.trim() {
+        "area" => Ok(Weighting::Area),
+        "unweighted" => Ok(Weighting::Unweighted),
+        other => match other.strip_prefix("mixed:") {
+            Some(mix) => Ok(Weighting::Mixed(parse_non_negative(mix.trim())?)),
+            None => Err(format!(
+                "`{s}` is not a weighting: use area, unweighted or mixed:S (e.g. mixed:1)"
+            )),
+        },
     }
 }
 
@@ -204,10 +216,7 @@ impl SimplifyFlags {
                 QuadricsFlag::Sum => QuadricMode::Sum,
                 QuadricsFlag::Exact => QuadricMode::Exact,
             })
-            .with_weighting(match self.weighting {
-                WeightingFlag::Area => Weighting::Area,
-                WeightingFlag::Unweighted => Weighting::Unweighted,
-            });
+            .with_weighting(self.weighting);
         Ok(match &self.lock {
             Some(path) => {
                 options.with_locked_vertices(read_lock_file(path).map_err(Failure::Failed)?)
@@ -231,5 +240,44 @@ mod tests {
         assert!(parse_ratio("x")
             .unwrap_err()
             .contains("`x` is not a number"));
+    }
+
+    #[test]
+    fn weighting_values() {
+        assert_eq!(parse_weighting("area"), Ok(Weighting::Area));
+        assert_eq!(parse_weighting("unweighted"), Ok(Weighting::Unweighted));
+        assert_eq!(parse_weighting("mixed:0.5"), Ok(Weighting::Mixed(0.5)));
+        assert_eq!(parse_weighting(" mixed: 2 "), Ok(Weighting::Mixed(2.0)));
+        assert!(parse_weighting("mixed:-1").is_err());
+        assert!(parse_weighting("mixed:inf").is_err());
+        assert!(parse_weighting("mixed").unwrap_err().contains("mixed:S"));
+        assert!(parse_weighting("Area").is_err());
+    }
+
+    #[test]
+    fn default_weighting_flag_is_the_library_default() {
+        assert_eq!(
+            parse_weighting(DEFAULT_WEIGHTING_FLAG),
+            Ok(SimplifyOptions::DEFAULT.weighting)
+        );
+        assert_eq!(
+            parse_weighting(DEFAULT_WEIGHTING_FLAG),
+            Ok(Weighting::Mixed(qem_mesh::simplify::DEFAULT_WEIGHTING_MIX))
+        );
+    }
+
+    #[test]
+    fn default_flags_give_the_library_defaults() {
+        use clap::Parser;
+        #[derive(Parser)]
+        struct Cli {
+            #[command(flatten)]
+            flags: SimplifyFlags,
+        }
+        let options = Cli::parse_from(["qem"])
+            .flags
+            .options()
+            .expect("no lock file");
+        assert_eq!(options, SimplifyOptions::DEFAULT);
     }
 }

@@ -108,6 +108,31 @@ impl Quadric {
         }
     }
 
+    /// The quadric of a triangle's plane with weight `area + extra`: between
+    /// [`from_triangle`](Quadric::from_triangle) (`extra = 0`, identical to it bit for
+    /// bit) and [`from_triangle_unweighted`](Quadric::from_triangle_unweighted) (`extra`
+    /// much larger than any area, up to a common factor). The simplifier's
+    /// `Weighting::Mixed` passes a multiple of the mean face area, so slivers still count
+    /// less than large faces but small faces are not drowned out by large ones.
+    ///
+    /// A degenerate triangle (zero area) has no plane and gives [`Quadric::ZERO`],
+    /// whatever `extra` is.
+    ///
+    /// ```
+    /// use glam::DVec3;
+    /// use qem_core::Quadric;
+    /// // A right triangle of area 0.5 in z = 0, with 1.5 added: weight 2.
+    /// let q = Quadric::from_triangle_area_plus(DVec3::ZERO, DVec3::X, DVec3::Y, 1.5);
+    /// assert_eq!(q.weight(), 2.0);
+    /// assert_eq!(q.evaluate(DVec3::new(0.2, 0.3, 3.0)), 2.0 * 9.0);
+    /// ```
+    pub fn from_triangle_area_plus(p0: DVec3, p1: DVec3, p2: DVec3, extra: f64) -> Quadric {
+        match unit_normal_and_area(p0, p1, p2) {
+            Some((n, area)) => Quadric::from_plane(n, -n.dot(p0)) * (area + extra),
+            None => Quadric::ZERO,
+        }
+    }
+
     /// The boundary constraint plane of the edge `p0`–`p1` of a face with normal
     /// `face_normal`: the plane through the edge perpendicular to the face, scaled by
     /// `weight`.

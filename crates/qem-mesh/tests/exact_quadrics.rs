@@ -84,11 +84,27 @@ impl Observer for BruteForce {
         self.incident = vec![Vec::new(); mesh.vertex_count()];
         self.groups = (0..mesh.vertex_count() as u32).map(|i| vec![i]).collect();
         let mut edge_faces: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
+        // Weighting::Mixed(s) adds s times the mean face area to every face's weight
+        // (and to the border planes' |edge|²).
+        let area = |t: &[u32; 3]| {
+            let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
+            0.5 * (b - a).cross(c - a).length()
+        };
+        let mean_area =
+            mesh.triangles.iter().map(area).sum::<f64>() / mesh.triangles.len().max(1) as f64;
+        let offset = match self.weighting {
+            Weighting::Mixed(s) => s * mean_area,
+            _ => 0.0,
+        };
         for (f, t) in mesh.triangles.iter().enumerate() {
             let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
             let q = match self.weighting {
                 Weighting::Area => Quadric::from_triangle(a, b, c),
                 Weighting::Unweighted => Quadric::from_triangle_unweighted(a, b, c),
+                Weighting::Mixed(_) => {
+                    let unit = Quadric::from_triangle_unweighted(a, b, c);
+                    unit * (area(t) + offset)
+                }
             };
             self.add(t.to_vec(), q);
             for i in 0..3 {
@@ -109,6 +125,7 @@ impl Observer for BruteForce {
                 let weight = match self.weighting {
                     Weighting::Area => w * p(x).distance_squared(p(y)),
                     Weighting::Unweighted => w,
+                    Weighting::Mixed(_) => w * (p(x).distance_squared(p(y)) + offset),
                 };
                 self.add(
                     vec![x, y],
@@ -260,18 +277,18 @@ fn options() -> impl Strategy<Value = SimplifyOptions> {
             Just(BoundaryMode::Free),
             (0.1..100.0f64).prop_map(BoundaryMode::Planes)
         ],
-        any::<bool>(),
+        prop_oneof![
+            Just(Weighting::Area),
+            Just(Weighting::Unweighted),
+            (0.0..10.0f64).prop_map(Weighting::Mixed)
+        ],
         any::<bool>(),
     )
-        .prop_map(|(r, t, boundary, unweighted, topology)| {
+        .prop_map(|(r, t, boundary, weighting, topology)| {
             exact(r)
                 .with_pair_threshold(Length::DiagonalFraction(t))
                 .with_boundary(boundary)
-                .with_weighting(if unweighted {
-                    Weighting::Unweighted
-                } else {
-                    Weighting::Area
-                })
+                .with_weighting(weighting)
                 .with_preserve_topology(topology)
         })
 }

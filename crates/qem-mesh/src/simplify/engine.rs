@@ -3,9 +3,7 @@
 use super::checks::Rejection;
 use super::exact::ExactQuadrics;
 use super::observer::{Contraction, Observer, Progress};
-use super::options::{
-    BoundaryMode, PlacementMode, QuadricMode, SimplifyOptions, VirtualPairs, Weighting,
-};
+use super::options::{BoundaryMode, PlacementMode, QuadricMode, SimplifyOptions, VirtualPairs};
 use super::orientation::InputSurface;
 use super::report::{SimplifyError, StopReason};
 use crate::clean::min_double_area;
@@ -14,7 +12,8 @@ use crate::queue::{Candidate, PairQueue};
 use crate::store::{EdgeKey, FaceKey, MeshStore, VertexKey};
 use crate::IndexedMesh;
 use qem_core::{
-    endpoint_placement, optimal_placement, DVec3, Frame, Placement, PlacementRule, Quadric,
+    endpoint_placement, optimal_placement, unit_normal_and_area, DVec3, Frame, Placement,
+    PlacementRule, Quadric,
 };
 use slotmap::SecondaryMap;
 use smallvec::SmallVec;
@@ -230,6 +229,7 @@ impl Engine {
             );
         }
         let faces: Vec<_> = self.store.faces().collect();
+        let area_offset = options.weighting.area_offset(self.mean_face_area(&faces));
         for f in faces {
             let [a, b, c] = self.store.face_vertices(f);
             let (pa, pb, pc) = (
@@ -238,9 +238,9 @@ impl Engine {
                 self.normalized_position(c),
             );
             self.original_normals.insert(f, (pb - pa).cross(pc - pa));
-            let q = match options.weighting {
-                Weighting::Area => Quadric::from_triangle(pa, pb, pc),
-                Weighting::Unweighted => Quadric::from_triangle_unweighted(pa, pb, pc),
+            let q = match area_offset {
+                Some(extra) => Quadric::from_triangle_area_plus(pa, pb, pc, extra),
+                None => Quadric::from_triangle_unweighted(pa, pb, pc),
             };
             for v in [a, b, c] {
                 if let Some(s) = self.state.get_mut(v) {
@@ -251,7 +251,7 @@ impl Engine {
                 exact.add_face(f, self.store.face_edges(f), q);
             }
         }
-        self.initialise_boundary(options);
+        self.initialise_boundary(options, area_offset);
         for &i in locked {
             if let Some(s) = keys.get(i as usize).and_then(|&v| self.state.get_mut(v)) {
                 s.locked = true;
@@ -276,8 +276,29 @@ impl Engine {
         }
     }
 
+    /// The mean area of `faces` in normalised units (degenerate faces count as 0), for
+    /// [`Weighting::Mixed`]; 0 when there are none.
+    fn mean_face_area(&self, faces: &[FaceKey]) -> f64 {
+        if faces.is_empty() {
+            return 0.0;
+        }
+        let total: f64 = faces
+            .iter()
+            .map(|&f| {
+                let [a, b, c] = self
+                    .store
+                    .face_vertices(f)
+                    .map(|v| self.normalized_position(v));
+                unit_normal_and_area(a, b, c).map_or(0.0, |(_, area)| area)
+            })
+            .sum();
+        total / faces.len() as f64
+    }
+
     /// Border planes ([`BoundaryMode::Planes`]) or border locks ([`BoundaryMode::Locked`]).
-    fn initialise_boundary(&mut self, options: &SimplifyOptions) {
+    /// `area_offset` is the weighting's constant added to face areas
+    /// ([`Weighting::area_offset`](super::Weighting::area_offset); `None` = unit weights).
+    fn initialise_boundary(&mut self, options: &SimplifyOptions, area_offset: Option<f64>) {
         let weight = match options.boundary {
             BoundaryMode::Free => return,
             BoundaryMode::Planes(w) if w > 0.0 && w.is_finite() => Some(w),
@@ -306,9 +327,9 @@ impl Engine {
                 .map(|v| self.normalized_position(v));
             let normal = (p1 - p0).cross(p2 - p0).normalize_or_zero();
             let (pa, pb) = (self.normalized_position(a), self.normalized_position(b));
-            let plane_weight = match options.weighting {
-                Weighting::Area => w * pa.distance_squared(pb),
-                Weighting::Unweighted => w,
+            let plane_weight = match area_offset {
+                Some(extra) => w * (pa.distance_squared(pb) + extra),
+                None => w,
             };
             let q = Quadric::boundary_constraint(pa, pb, normal, plane_weight);
             for v in [a, b] {

@@ -27,6 +27,7 @@ pub use observer::{Contraction, NoObserver, Observer, Progress};
 pub use options::{
     BoundaryMode, Length, PlacementMode, QuadricMode, SimplifyOptions, Target, VirtualPairs,
     Weighting, DEFAULT_BOUNDARY_WEIGHT, DEFAULT_MAX_NORMAL_ANGLE, DEFAULT_MIN_TRIANGLE_QUALITY,
+    DEFAULT_WEIGHTING_MIX,
 };
 pub use report::{Simplified, SimplifyError, SimplifyReport, StopReason, Timings};
 
