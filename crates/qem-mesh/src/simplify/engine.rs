@@ -9,7 +9,7 @@ use super::options::{
 use super::report::{SimplifyError, StopReason};
 use crate::clean::min_double_area;
 use crate::pairs::grid::{virtual_pairs, GridOptions};
-use crate::queue::{Candidate, PairQueue};
+use crate::queue::PairQueue;
 use crate::store::{EdgeKey, FaceKey, MeshStore, VertexKey};
 use crate::IndexedMesh;
 use qem_core::{
@@ -21,19 +21,6 @@ use smallvec::SmallVec;
 /// How often (in contractions) the observer's progress is called.
 const OBSERVER_INTERVAL: usize = 4096;
 
-/// When the queue holds more than this many entries per live pair, stale entries are
-/// dropped. Why 2: a rebuild costs O(queue) and happens after at least as many pushes,
-/// so it adds O(1) amortised per push while keeping the heap within 2x of minimal.
-const STALE_REBUILD_FACTOR: usize = 2;
-
-/// Whether a queued pair still describes the two vertices as they are now.
-fn is_current(state: &SecondaryMap<VertexKey, VertexState>, c: &Candidate) -> bool {
-    match (state.get(c.a), state.get(c.b)) {
-        (Some(sa), Some(sb)) => sa.stamp == c.stamp_a && sb.stamp == c.stamp_b,
-        _ => false,
-    }
-}
-
 /// What the loop keeps per vertex: what the placement and the checks read on every
 /// pair, side by side. Why the position is here too (the store has it in world units):
 /// one lookup instead of two, and no conversion per read; it is always exactly
@@ -43,8 +30,6 @@ pub(super) struct VertexState {
     pub quadric: Quadric,
     /// The position in normalised units.
     pub position: DVec3,
-    /// Bumped whenever the quadric or position changes; see [`crate::queue`].
-    pub stamp: u32,
     /// Never moves, never disappears.
     pub locked: bool,
     /// Index in the cleaned mesh (for [`Contraction`] events).
@@ -134,6 +119,8 @@ pub(super) struct Engine {
     scratch: Vec<(VertexKey, Option<EdgeKey>)>,
     /// Reused buffer of the faces around a vertex.
     pub face_scratch: Vec<FaceKey>,
+    /// Reused buffer of the edges of the vertex being removed.
+    b_edges: Vec<EdgeKey>,
 }
 
 impl Engine {
@@ -158,7 +145,7 @@ impl Engine {
         };
         Engine {
             state: SecondaryMap::with_capacity(store.vertex_count()),
-            queue: PairQueue::with_capacity(store.edge_count() * 2),
+            queue: PairQueue::new(&store),
             exact: (options.quadrics == QuadricMode::Exact).then(|| ExactQuadrics::new(&store)),
             original_normals: SecondaryMap::with_capacity(store.face_count()),
             partners: SecondaryMap::new(),
@@ -168,6 +155,7 @@ impl Engine {
             counters: Counters::default(),
             scratch: Vec::new(),
             face_scratch: Vec::new(),
+            b_edges: Vec::new(),
         }
     }
 
@@ -380,15 +368,12 @@ impl Engine {
 
     fn push_pair(&mut self, a: VertexKey, b: VertexKey, ab: Option<EdgeKey>) {
         let (placed, _) = self.place(a, b, ab);
-        self.queue.push(Candidate {
-            cost: placed.cost,
-            a,
-            b,
-            stamp_a: self.state[a].stamp,
-            stamp_b: self.state[b].stamp,
-        });
+        self.queue.push(placed.cost, a, b, ab);
     }
 
+    // Out of line (it runs once per level, so this costs nothing) so that profilers
+    // can count the loop alone, e.g. `valgrind --toggle-collect='*Engine::run*'`.
+    #[inline(never)]
     pub fn run(
         &mut self,
         target: usize,
@@ -404,9 +389,6 @@ impl Engine {
             let Some(candidate) = self.queue.pop() else {
                 break StopReason::NoValidPair;
             };
-            if !is_current(&self.state, &candidate) {
-                continue;
-            }
             let (mut a, mut b) = (candidate.a, candidate.b);
             // Cheapest checks first: locks are two flags.
             let (locked_a, locked_b) = (self.state[a].locked, self.state[b].locked);
@@ -418,7 +400,10 @@ impl Engine {
                 // The locked vertex is the one that stays.
                 std::mem::swap(&mut a, &mut b);
             }
-            let ab = self.store.find_edge(a, b);
+            // The queue keeps every entry current (see `contract`), so the edge it
+            // was queued with still joins the two.
+            let ab = candidate.edge;
+            debug_assert_eq!(ab, self.store.find_edge(a, b));
             // Never contract the last faces away: the output must keep a triangle.
             let shared_faces = ab.map_or(0, |e| self.store.fan(e).len());
             if shared_faces >= self.store.face_count() {
@@ -453,17 +438,6 @@ impl Engine {
             });
             if options.validate_each_contraction {
                 self.store.validate().map_err(SimplifyError::Internal)?;
-            }
-
-            // Each contraction queues a fresh entry per neighbour and leaves the old
-            // ones stale; once stale entries dominate, drop them in one O(n) pass so
-            // the heap (and every pop) stays proportional to the live pairs.
-            if self.queue.len()
-                > STALE_REBUILD_FACTOR * (self.store.edge_count() + self.counters.virtual_pairs)
-                    + 1024
-            {
-                let state = &self.state;
-                self.queue.retain(|c| is_current(state, c));
             }
 
             since_report += 1;
@@ -512,8 +486,23 @@ impl Engine {
         } else {
             self.counters.virtual_contractions += 1;
         }
-        // Both keys are live (checked by is_current) and distinct (pairs are built from
-        // edges and from distinct grid points), so contraction cannot fail.
+        // The queue's pairs of `b` all go: its edges either move to `a` (and are re-queued
+        // below under the same id) or merge away (removed after the contraction), and
+        // its virtual pairs end with it. `a`'s virtual pairs are dropped too and the
+        // current ones re-queued below, since merging partners may turn one into an edge.
+        let mut b_edges = std::mem::take(&mut self.b_edges);
+        b_edges.clear();
+        b_edges.extend_from_slice(self.store.star(b));
+        for v in [a, b] {
+            if let Some(partners) = self.partners.get(v) {
+                for &p in partners {
+                    self.queue.remove_virtual(v, p);
+                }
+            }
+        }
+        // Both keys are live (the queue holds only pairs of live vertices) and distinct
+        // (pairs are built from edges and from distinct grid points), so contraction
+        // cannot fail.
         let contracted = match &mut self.exact {
             Some(exact) => exact.contract(&mut self.store, a, b, ab, world.to_array()),
             None => self
@@ -522,8 +511,15 @@ impl Engine {
                 .map(|_| ()),
         };
         if contracted.is_err() {
+            self.b_edges = b_edges;
             return;
         }
+        for &e in &b_edges {
+            if !self.store.contains_edge(e) {
+                self.queue.remove_edge(e);
+            }
+        }
+        self.b_edges = b_edges;
 
         self.state.remove(b);
         if !self.partners.is_empty() {
@@ -532,7 +528,6 @@ impl Engine {
         let sa = &mut self.state[a];
         sa.quadric = q;
         sa.position = self.frame.to_normalized(world);
-        sa.stamp = sa.stamp.wrapping_add(1);
 
         // Re-cost every pair around the new vertex.
         let mut neighbours = std::mem::take(&mut self.scratch);
