@@ -19,7 +19,7 @@
 //! half as often.
 
 use crate::store::{EdgeKey, MeshStore, VertexKey};
-use slotmap::Key;
+use slotmap::{Key, KeyData};
 use std::collections::HashMap;
 
 /// Children per node of the heap.
@@ -32,6 +32,64 @@ const ABSENT: u32 = u32::MAX;
 /// lives (the loop never inserts into the store, so slots are not reused under it).
 fn slot<K: Key>(key: K) -> usize {
     (key.data().as_ffi() & u64::from(u32::MAX)) as usize
+}
+
+/// Slot keys as dense 32-bit numbers in `as_ffi` order, and back.
+///
+/// A store fresh from [`MeshStore::from_mesh`] has never removed anything, so all its
+/// keys share one version and the slot index alone is such a number (no table at
+/// all). Otherwise the keys are ranked once, and two tables convert.
+#[derive(Debug)]
+enum Numbering<K> {
+    /// Every key has this version: a key's number is its slot index.
+    OneVersion(u32),
+    /// The number of the key in each slot, and the key of each number.
+    Ranked { number: Vec<u32>, keys: Vec<K> },
+}
+
+impl<K: Key> Numbering<K> {
+    fn new(keys: impl Iterator<Item = K>) -> Self {
+        let mut keys: Vec<K> = keys.collect();
+        let version = |k: &K| (k.data().as_ffi() >> 32) as u32;
+        match keys.first().map(version) {
+            None => return Numbering::OneVersion(1),
+            Some(v) if keys.iter().all(|k| version(k) == v) => {
+                return Numbering::OneVersion(v);
+            }
+            Some(_) => {}
+        }
+        keys.sort_unstable_by_key(|k| k.data().as_ffi());
+        let slots = keys.iter().map(|&k| slot(k) + 1).max().unwrap_or(0);
+        let mut number = vec![0; slots];
+        for (n, &k) in keys.iter().enumerate() {
+            number[slot(k)] = n as u32;
+        }
+        Numbering::Ranked { number, keys }
+    }
+
+    #[inline]
+    fn number(&self, key: K) -> u32 {
+        match self {
+            Numbering::OneVersion(_) => slot(key) as u32,
+            Numbering::Ranked { number, .. } => number[slot(key)],
+        }
+    }
+
+    #[inline]
+    fn key(&self, number: u32) -> K {
+        match self {
+            Numbering::OneVersion(version) => {
+                KeyData::from_ffi(u64::from(*version) << 32 | u64::from(number)).into()
+            }
+            Numbering::Ranked { keys, .. } => keys[number as usize],
+        }
+    }
+}
+
+impl<K> Default for Numbering<K> {
+    fn default() -> Self {
+        Numbering::OneVersion(1)
+    }
 }
 
 /// `cost` as an integer whose unsigned order is `f64::total_cmp`'s order.
@@ -88,21 +146,20 @@ pub(crate) struct Popped {
 /// Candidate pairs ordered by cost: a 4-ary min-heap, root at index 0, children of `i`
 /// at `ARITY * i + 1 ..= ARITY * i + ARITY`, with the heap index of every id.
 ///
-/// Vertices are compared by *rank*: their position in the `as_ffi` order of all the
-/// store's vertex keys when the queue was made. Ranks fit in 32 bits, so a pair's
-/// tie-break is one `u64`, and comparing ranks is comparing keys (the store gains no
-/// vertex while the queue lives).
+/// Vertices are compared by their [`Numbering`], whose order is the `as_ffi` order of
+/// the keys, so a pair's tie-break is one `u64` (the store gains no vertex while the
+/// queue lives, so the numbering stays valid).
 #[derive(Debug, Default)]
 pub(crate) struct PairQueue {
     heap: Vec<Entry>,
     /// Heap index of every id, [`ABSENT`] when not queued.
     position: Vec<u32>,
-    /// Rank of the vertex in each slot.
-    rank: Vec<u32>,
-    /// The vertex of each rank.
-    by_rank: Vec<VertexKey>,
-    /// The edge of each edge id (= its slot index).
-    edge_keys: Vec<EdgeKey>,
+    /// Vertex numbers for the tie-break.
+    vertices: Numbering<VertexKey>,
+    /// The edge of each edge id (= its slot index, which is also its number here).
+    edges: Numbering<EdgeKey>,
+    /// Ids below this are edges.
+    edge_slots: usize,
     /// Ids of the virtual pairs, by their two vertex keys (`as_ffi`, smaller first).
     /// Only ever looked up, never iterated, so its hash order cannot reach an output.
     virtual_ids: HashMap<(u64, u64), u32>,
@@ -113,24 +170,22 @@ pub(crate) struct PairQueue {
 impl PairQueue {
     /// An empty queue for the pairs of `store`'s vertices and edges.
     pub fn new(store: &MeshStore) -> Self {
-        let mut by_rank: Vec<VertexKey> = store.vertices().collect();
-        by_rank.sort_unstable_by_key(|v| v.data().as_ffi());
-        let vertex_slots = by_rank.iter().map(|&v| slot(v) + 1).max().unwrap_or(0);
-        let mut rank = vec![0; vertex_slots];
-        for (r, &v) in by_rank.iter().enumerate() {
-            rank[slot(v)] = r as u32;
-        }
         let edge_slots = store.edges().map(|e| slot(e) + 1).max().unwrap_or(0);
-        let mut edge_keys = vec![EdgeKey::null(); edge_slots];
-        for e in store.edges() {
-            edge_keys[slot(e)] = e;
+        let mut edges = Numbering::new(store.edges());
+        if let Numbering::Ranked { keys, .. } = &mut edges {
+            // Edge numbers are slot indices, not ranks: the id of an edge is its slot.
+            let mut by_slot = vec![EdgeKey::null(); edge_slots];
+            for &e in keys.iter() {
+                by_slot[slot(e)] = e;
+            }
+            *keys = by_slot;
         }
         PairQueue {
             heap: Vec::with_capacity(store.edge_count()),
             position: vec![ABSENT; edge_slots],
-            rank,
-            by_rank,
-            edge_keys,
+            vertices: Numbering::new(store.vertices()),
+            edges,
+            edge_slots,
             virtual_ids: HashMap::new(),
             free_ids: Vec::new(),
         }
@@ -146,7 +201,7 @@ impl PairQueue {
     /// (handed out on first use).
     fn id(&mut self, a: VertexKey, b: VertexKey, edge: Option<EdgeKey>) -> u32 {
         if let Some(e) = edge {
-            debug_assert_eq!(self.edge_keys[slot(e)], e);
+            debug_assert_eq!(self.edges.key(slot(e) as u32), e);
             return slot(e) as u32;
         }
         let next = self.position.len() as u32;
@@ -169,7 +224,7 @@ impl PairQueue {
         let id = self.id(a, b, edge);
         let entry = Entry {
             cost: cost_bits(cost),
-            tie: u64::from(self.rank[slot(a)]) << 32 | u64::from(self.rank[slot(b)]),
+            tie: u64::from(self.vertices.number(a)) << 32 | u64::from(self.vertices.number(b)),
             id,
         };
         match self.position[id as usize] {
@@ -184,7 +239,7 @@ impl PairQueue {
     /// Takes the pair joined by `edge` out of the queue, if it is there.
     pub fn remove_edge(&mut self, edge: EdgeKey) {
         let id = slot(edge);
-        debug_assert_eq!(self.edge_keys[id], edge);
+        debug_assert_eq!(self.edges.key(id as u32), edge);
         self.remove_id(id);
     }
 
@@ -200,12 +255,11 @@ impl PairQueue {
     pub fn pop(&mut self) -> Option<Popped> {
         let top = *self.heap.first()?;
         self.remove_at(0);
-        let id = top.id as usize;
         Some(Popped {
             cost: cost_from_bits(top.cost),
-            a: self.by_rank[(top.tie >> 32) as usize],
-            b: self.by_rank[(top.tie & u64::from(u32::MAX)) as usize],
-            edge: self.edge_keys.get(id).copied(),
+            a: self.vertices.key((top.tie >> 32) as u32),
+            b: self.vertices.key(top.tie as u32),
+            edge: ((top.id as usize) < self.edge_slots).then(|| self.edges.key(top.id)),
         })
     }
 
@@ -309,6 +363,37 @@ mod tests {
             for y in costs {
                 assert_eq!(cost_bits(x).cmp(&cost_bits(y)), x.total_cmp(&y), "{x} {y}");
             }
+        }
+    }
+
+    /// Keys of several versions (a slot freed and taken again) are ranked in `as_ffi`
+    /// order; keys of one version are numbered by slot. Both convert back.
+    #[test]
+    fn numbering_follows_the_key_order() {
+        let mut map: slotmap::SlotMap<VertexKey, ()> = slotmap::SlotMap::with_key();
+        let first: Vec<VertexKey> = (0..5).map(|_| map.insert(())).collect();
+        let one = Numbering::new(map.keys());
+        assert!(matches!(one, Numbering::OneVersion(1)));
+        for &k in &first {
+            let n = one.number(k);
+            assert_eq!(n as usize, slot(k));
+            assert_eq!(one.key(n), k);
+        }
+        assert!(first
+            .windows(2)
+            .all(|w| one.number(w[0]) < one.number(w[1])));
+        map.remove(first[1]);
+        map.remove(first[3]);
+        let again = map.insert(()); // slot 3, version 3
+        let keys: Vec<VertexKey> = map.keys().collect();
+        let ranked = Numbering::new(keys.iter().copied());
+        assert!(matches!(ranked, Numbering::Ranked { .. }));
+        let mut sorted = keys.clone();
+        sorted.sort_by_key(|k| k.data().as_ffi());
+        assert_eq!(sorted.last(), Some(&again));
+        for (n, &k) in sorted.iter().enumerate() {
+            assert_eq!(ranked.number(k), n as u32);
+            assert_eq!(ranked.key(n as u32), k);
         }
     }
 
