@@ -12,11 +12,12 @@
 //! then the two vertices' slot keys in `KeyData::as_ffi` order), where `a` is the vertex
 //! the latest push named first. Two live entries never have equal keys (one entry per
 //! pair), so the heap's layout, which depends on the order of pushes, updates and
-//! removals, cannot change which pair pops next.
+//! removals, cannot change which pair pops next. `b` is kept beside the entry's
+//! position rather than in the entry, and read only when cost and `a` tie.
 //!
 //! The heap is 4-ary: half the levels of a binary heap, and the four children of a node
-//! are adjacent (96 bytes), so a sift through a heap larger than the cache misses about
-//! half as often.
+//! fill exactly one cache line (16-byte entries, aligned), so a sift through a heap
+//! larger than the cache misses at most once per level.
 
 use crate::store::{EdgeKey, MeshStore, VertexKey};
 use slotmap::{Key, KeyData};
@@ -111,24 +112,39 @@ fn cost_from_bits(bits: u64) -> f64 {
     }
 }
 
-/// One heap entry: the ordering key and the pair's id. 24 bytes.
-#[derive(Clone, Copy, Debug)]
+/// One heap entry: the cost, the first vertex and the pair's id, 16 bytes, so that the
+/// four children of a node fill one cache line (see [`Line`]). The second vertex, only
+/// needed on a tie of the first two, is in the id's [`Slot`].
+#[derive(Clone, Copy, Debug, Default)]
 struct Entry {
     /// [`cost_bits`] of the cost.
     cost: u64,
-    /// `rank(a) << 32 | rank(b)`: the tie-break in slot-key order (see [`PairQueue`]).
-    tie: u64,
+    /// The [`Numbering`] of the vertex the push named first.
+    first: u32,
     /// The pair's id: an edge's slot index, or a virtual pair's id past the edges.
     id: u32,
 }
 
-impl Entry {
-    /// Whether `self` pops before `other`.
-    #[inline]
-    fn before(&self, other: &Entry) -> bool {
-        (self.cost, self.tie) < (other.cost, other.tie)
-    }
+/// What the queue keeps per id, 8 bytes: where its entry is and its second vertex.
+#[derive(Clone, Copy, Debug)]
+struct Slot {
+    /// Heap index of the entry, [`ABSENT`] when not queued.
+    position: u32,
+    /// The [`Numbering`] of the vertex the push named second.
+    second: u32,
 }
+
+const NO_SLOT: Slot = Slot {
+    position: ABSENT,
+    second: 0,
+};
+
+/// The four children of one node, aligned to a cache line: the heap is stored three
+/// entries late, so that the children `4i + 1 ..= 4i + 4` of node `i` are exactly
+/// line `i + 1` and a sift down reads one line per level.
+#[derive(Clone, Copy, Debug, Default)]
+#[repr(align(64))]
+struct Line([Entry; ARITY]);
 
 /// A popped pair.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -144,16 +160,20 @@ pub(crate) struct Popped {
 }
 
 /// Candidate pairs ordered by cost: a 4-ary min-heap, root at index 0, children of `i`
-/// at `ARITY * i + 1 ..= ARITY * i + ARITY`, with the heap index of every id.
+/// at `ARITY * i + 1 ..= ARITY * i + ARITY` (stored in [`Line`]s), with the heap index
+/// of every id.
 ///
 /// Vertices are compared by their [`Numbering`], whose order is the `as_ffi` order of
 /// the keys, so a pair's tie-break is one `u64` (the store gains no vertex while the
 /// queue lives, so the numbering stays valid).
 #[derive(Debug, Default)]
 pub(crate) struct PairQueue {
-    heap: Vec<Entry>,
-    /// Heap index of every id, [`ABSENT`] when not queued.
-    position: Vec<u32>,
+    /// The heap, three entries late (see [`Line`]).
+    lines: Vec<Line>,
+    /// Number of entries in the heap.
+    len: usize,
+    /// Position and second vertex of every id.
+    slots: Vec<Slot>,
     /// Vertex numbers for the tie-break.
     vertices: Numbering<VertexKey>,
     /// The edge of each edge id (= its slot index, which is also its number here).
@@ -181,8 +201,9 @@ impl PairQueue {
             *keys = by_slot;
         }
         PairQueue {
-            heap: Vec::with_capacity(store.edge_count()),
-            position: vec![ABSENT; edge_slots],
+            lines: Vec::with_capacity(store.edge_count() / ARITY + 2),
+            len: 0,
+            slots: vec![NO_SLOT; edge_slots],
             vertices: Numbering::new(store.vertices()),
             edges,
             edge_slots,
@@ -194,7 +215,34 @@ impl PairQueue {
     /// Number of queued pairs.
     #[cfg(test)]
     pub fn len(&self) -> usize {
-        self.heap.len()
+        self.len
+    }
+
+    /// The entry at heap index `i`.
+    #[inline]
+    fn get(&self, i: usize) -> Entry {
+        let p = i + ARITY - 1;
+        self.lines[p / ARITY].0[p % ARITY]
+    }
+
+    /// Writes the entry at heap index `i` and records its position.
+    #[inline]
+    fn set(&mut self, i: usize, entry: Entry) {
+        let p = i + ARITY - 1;
+        self.lines[p / ARITY].0[p % ARITY] = entry;
+        self.slots[entry.id as usize].position = i as u32;
+    }
+
+    /// Whether `x` pops before `y` (two entries of different pairs).
+    #[inline]
+    fn before(&self, x: &Entry, y: &Entry) -> bool {
+        match (x.cost, x.first).cmp(&(y.cost, y.first)) {
+            std::cmp::Ordering::Less => true,
+            std::cmp::Ordering::Greater => false,
+            std::cmp::Ordering::Equal => {
+                self.slots[x.id as usize].second < self.slots[y.id as usize].second
+            }
+        }
     }
 
     /// The id of the pair `a`–`b` joined by `edge`, or of the virtual pair `a`–`b`
@@ -204,15 +252,15 @@ impl PairQueue {
             debug_assert_eq!(self.edges.key(slot(e) as u32), e);
             return slot(e) as u32;
         }
-        let next = self.position.len() as u32;
+        let next = self.slots.len() as u32;
         let free = &mut self.free_ids;
-        let position = &mut self.position;
+        let slots = &mut self.slots;
         *self
             .virtual_ids
             .entry(virtual_key(a, b))
             .or_insert_with(|| {
                 free.pop().unwrap_or_else(|| {
-                    position.push(ABSENT);
+                    slots.push(NO_SLOT);
                     next
                 })
             })
@@ -224,13 +272,18 @@ impl PairQueue {
         let id = self.id(a, b, edge);
         let entry = Entry {
             cost: cost_bits(cost),
-            tie: u64::from(self.vertices.number(a)) << 32 | u64::from(self.vertices.number(b)),
+            first: self.vertices.number(a),
             id,
         };
-        match self.position[id as usize] {
+        let slot = &mut self.slots[id as usize];
+        slot.second = self.vertices.number(b);
+        match slot.position {
             ABSENT => {
-                self.heap.push(entry);
-                self.sift_up(self.heap.len() - 1, entry);
+                self.len += 1;
+                if (self.len + ARITY - 2) / ARITY >= self.lines.len() {
+                    self.lines.push(Line::default());
+                }
+                self.sift_up(self.len - 1, entry);
             }
             i => self.replace(i as usize, entry),
         }
@@ -253,18 +306,21 @@ impl PairQueue {
 
     /// Removes and returns the cheapest pair.
     pub fn pop(&mut self) -> Option<Popped> {
-        let top = *self.heap.first()?;
+        if self.len == 0 {
+            return None;
+        }
+        let top = self.get(0);
         self.remove_at(0);
         Some(Popped {
             cost: cost_from_bits(top.cost),
-            a: self.vertices.key((top.tie >> 32) as u32),
-            b: self.vertices.key(top.tie as u32),
+            a: self.vertices.key(top.first),
+            b: self.vertices.key(self.slots[top.id as usize].second),
             edge: ((top.id as usize) < self.edge_slots).then(|| self.edges.key(top.id)),
         })
     }
 
     fn remove_id(&mut self, id: usize) {
-        match self.position[id] {
+        match self.slots[id].position {
             ABSENT => {}
             i => self.remove_at(i as usize),
         }
@@ -272,19 +328,19 @@ impl PairQueue {
 
     /// Removes the entry at heap index `i`.
     fn remove_at(&mut self, i: usize) {
-        self.position[self.heap[i].id as usize] = ABSENT;
-        let Some(last) = self.heap.pop() else {
-            return;
-        };
-        if i < self.heap.len() {
+        let removed = self.get(i).id;
+        self.len -= 1;
+        if i < self.len {
+            let last = self.get(self.len);
             self.replace(i, last);
         }
+        self.slots[removed as usize].position = ABSENT;
     }
 
     /// Puts `entry` at heap index `i` in place of what was there, then restores the
     /// heap order.
     fn replace(&mut self, i: usize, entry: Entry) {
-        if entry.before(&self.heap[i]) {
+        if self.before(&entry, &self.get(i)) {
             self.sift_up(i, entry);
         } else {
             self.sift_down(i, entry);
@@ -295,42 +351,41 @@ impl PairQueue {
     fn sift_up(&mut self, mut i: usize, moving: Entry) {
         while i > 0 {
             let parent = (i - 1) / ARITY;
-            let above = self.heap[parent];
-            if !moving.before(&above) {
+            let above = self.get(parent);
+            if !self.before(&moving, &above) {
                 break;
             }
-            self.heap[i] = above;
-            self.position[above.id as usize] = i as u32;
+            self.set(i, above);
             i = parent;
         }
-        self.heap[i] = moving;
-        self.position[moving.id as usize] = i as u32;
+        self.set(i, moving);
     }
 
     /// Places `moving` at or below the hole at `i`, until no child pops before it.
     fn sift_down(&mut self, mut i: usize, moving: Entry) {
-        let len = self.heap.len();
+        let len = self.len;
         loop {
             let first = ARITY * i + 1;
             if first >= len {
                 break;
             }
-            let mut best = first;
-            for child in first + 1..(first + ARITY).min(len) {
-                if self.heap[child].before(&self.heap[best]) {
-                    best = child;
+            // The children are line i + 1.
+            let children = &self.lines[i + 1].0;
+            let count = (len - first).min(ARITY);
+            let mut best = 0;
+            for c in 1..count {
+                if self.before(&children[c], &children[best]) {
+                    best = c;
                 }
             }
-            let below = self.heap[best];
-            if !below.before(&moving) {
+            let below = children[best];
+            if !self.before(&below, &moving) {
                 break;
             }
-            self.heap[i] = below;
-            self.position[below.id as usize] = i as u32;
-            i = best;
+            self.set(i, below);
+            i = first + best;
         }
-        self.heap[i] = moving;
-        self.position[moving.id as usize] = i as u32;
+        self.set(i, moving);
     }
 }
 
@@ -344,6 +399,13 @@ fn virtual_key(a: VertexKey, b: VertexKey) -> (u64, u64) {
 mod tests {
     use super::*;
     use crate::IndexedMesh;
+
+    #[test]
+    fn four_entries_fill_one_cache_line() {
+        assert_eq!(std::mem::size_of::<Entry>(), 16);
+        assert_eq!(std::mem::size_of::<Line>(), 64);
+        assert_eq!(std::mem::align_of::<Line>(), 64);
+    }
 
     #[test]
     fn cost_bits_keep_the_total_order() {
