@@ -212,7 +212,10 @@ impl MeshStore {
     pub fn find_edge(&self, a: VertexKey, b: VertexKey) -> Option<EdgeKey> {
         let sa = &self.vertices[a].star;
         if sa.len() <= SHORT_STAR {
-            return sa.iter().copied().find(|&e| self.other_vertex(e, a) == Some(b));
+            return sa
+                .iter()
+                .copied()
+                .find(|&e| self.other_vertex(e, a) == Some(b));
         }
         let sb = &self.vertices[b].star;
         let (star, from) = if sa.len() <= sb.len() {
