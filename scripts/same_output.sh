@@ -35,6 +35,7 @@ optsets=(
   "--ratio 0.1 --min-quality 0.3 --weighting unweighted"
   "--ratio 0.1 --lock $work/lock.txt"
   "--lods 0.5,0.2,0.05"
+  "--lods 0.5,0.1,0.01 --max-error 0.001"
 )
 
 strip() {
