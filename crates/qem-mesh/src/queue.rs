@@ -1,179 +1,483 @@
-//! The priority queue of candidate pairs, cheapest first, with lazy invalidation.
+//! The priority queue of candidate pairs, cheapest first, with one entry per live pair.
 //!
 //! A contraction changes the quadric of the surviving vertex, so every queued pair that
-//! touches it is out of date. Instead of finding and removing those entries (a heap
-//! cannot do that cheaply), each vertex carries a *stamp* that is bumped whenever its
-//! quadric or position changes; an entry remembers the stamps of its two vertices when
-//! it was pushed, and a popped entry whose stamps no longer match is simply dropped.
+//! touches it must be re-costed, and every pair of the removed vertex must go. The queue
+//! is *addressable*: each pair has an id (an edge's slot index, or an id handed out for
+//! a virtual pair), the heap records where each id sits, and a re-costed pair is moved
+//! in place instead of being queued a second time. Why not lazy invalidation (stamps,
+//! stale entries dropped at pop): the stale entries doubled the heap, every pop sifted
+//! through a heap far larger than the cache, and a periodic pass had to sweep them out.
 //!
-//! The heap is 4-ary rather than binary (`std`'s `BinaryHeap`): half as many levels, and
-//! the four children of a node are adjacent (128 bytes, two cache lines), so a pop that
-//! sifts down through a heap far larger than the cache misses about half as often. Pop
-//! order is fixed by [`Candidate`]'s total order alone (cost, then keys): entries that
-//! compare equal name the same pair with the same cost, so which of them pops first
-//! cannot change a run.
+//! Pop order is fixed by the key alone, `(cost, a, b)` compared as (`f64::total_cmp`,
+//! then the two vertices' slot keys in `KeyData::as_ffi` order), where `a` is the vertex
+//! the latest push named first. Two live entries never have equal keys (one entry per
+//! pair), so the heap's layout, which depends on the order of pushes, updates and
+//! removals, cannot change which pair pops next. `b` is kept beside the entry's
+//! position rather than in the entry, and read only when cost and `a` tie.
+//!
+//! The heap is 4-ary: half the levels of a binary heap, and the four children of a node
+//! fill exactly one cache line (16-byte entries, aligned), so a sift through a heap
+//! larger than the cache misses at most once per level.
 
-use crate::store::VertexKey;
-use slotmap::Key;
-use std::cmp::Ordering;
-
-/// One queued pair: its cost when pushed and the stamps that make it current.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Candidate {
-    /// The quadric cost of contracting the pair (normalised units).
-    pub cost: f64,
-    /// First vertex (the one that survives).
-    pub a: VertexKey,
-    /// Second vertex (the one that is removed).
-    pub b: VertexKey,
-    /// Stamp of `a` when pushed.
-    pub stamp_a: u32,
-    /// Stamp of `b` when pushed.
-    pub stamp_b: u32,
-}
-
-impl Candidate {
-    /// The deterministic tie-break: the slot keys of the two vertices.
-    fn tie_key(&self) -> (u64, u64) {
-        (self.a.data().as_ffi(), self.b.data().as_ffi())
-    }
-}
-
-impl PartialEq for Candidate {
-    fn eq(&self, other: &Self) -> bool {
-        self.cmp(other) == Ordering::Equal
-    }
-}
-
-impl Eq for Candidate {}
-
-impl PartialOrd for Candidate {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-
-impl Ord for Candidate {
-    /// Reversed, so that the max-heap pops the cheapest pair first; equal
-    /// costs pop in increasing key order, which makes every run reproducible.
-    fn cmp(&self, other: &Self) -> Ordering {
-        other
-            .cost
-            .total_cmp(&self.cost)
-            .then_with(|| other.tie_key().cmp(&self.tie_key()))
-    }
-}
+use crate::store::{EdgeKey, MeshStore, VertexKey};
+use slotmap::{Key, KeyData};
+use std::collections::HashMap;
 
 /// Children per node of the heap.
 const ARITY: usize = 4;
 
-/// Candidate pairs ordered by cost: a 4-ary max-heap under [`Candidate`]'s (reversed)
-/// order, root at index 0, children of `i` at `ARITY * i + 1 ..= ARITY * i + ARITY`.
+/// Marks an id that is not in the heap.
+const ABSENT: u32 = u32::MAX;
+
+/// The slot index of a key: unique among live keys, and stable for as long as the key
+/// lives (the loop never inserts into the store, so slots are not reused under it).
+fn slot<K: Key>(key: K) -> usize {
+    (key.data().as_ffi() & u64::from(u32::MAX)) as usize
+}
+
+/// Slot keys as dense 32-bit numbers in `as_ffi` order, and back.
+///
+/// A store fresh from [`MeshStore::from_mesh`] has never removed anything, so all its
+/// keys share one version and the slot index alone is such a number (no table at
+/// all). Otherwise the keys are ranked once, and two tables convert.
+#[derive(Debug)]
+enum Numbering<K> {
+    /// Every key has this version: a key's number is its slot index.
+    OneVersion(u32),
+    /// The number of the key in each slot, and the key of each number.
+    Ranked { number: Vec<u32>, keys: Vec<K> },
+}
+
+impl<K: Key> Numbering<K> {
+    fn new(keys: impl Iterator<Item = K>) -> Self {
+        let mut keys: Vec<K> = keys.collect();
+        let version = |k: &K| (k.data().as_ffi() >> 32) as u32;
+        match keys.first().map(version) {
+            None => return Numbering::OneVersion(1),
+            Some(v) if keys.iter().all(|k| version(k) == v) => {
+                return Numbering::OneVersion(v);
+            }
+            Some(_) => {}
+        }
+        keys.sort_unstable_by_key(|k| k.data().as_ffi());
+        let slots = keys.iter().map(|&k| slot(k) + 1).max().unwrap_or(0);
+        let mut number = vec![0; slots];
+        for (n, &k) in keys.iter().enumerate() {
+            number[slot(k)] = n as u32;
+        }
+        Numbering::Ranked { number, keys }
+    }
+
+    #[inline]
+    fn number(&self, key: K) -> u32 {
+        match self {
+            Numbering::OneVersion(_) => slot(key) as u32,
+            Numbering::Ranked { number, .. } => number[slot(key)],
+        }
+    }
+
+    #[inline]
+    fn key(&self, number: u32) -> K {
+        match self {
+            Numbering::OneVersion(version) => {
+                KeyData::from_ffi(u64::from(*version) << 32 | u64::from(number)).into()
+            }
+            Numbering::Ranked { keys, .. } => keys[number as usize],
+        }
+    }
+}
+
+impl<K> Default for Numbering<K> {
+    fn default() -> Self {
+        Numbering::OneVersion(1)
+    }
+}
+
+/// `cost` as an integer whose unsigned order is `f64::total_cmp`'s order.
+fn cost_bits(cost: f64) -> u64 {
+    let bits = cost.to_bits();
+    if bits >> 63 == 1 {
+        !bits
+    } else {
+        bits | 1 << 63
+    }
+}
+
+/// The inverse of [`cost_bits`].
+fn cost_from_bits(bits: u64) -> f64 {
+    if bits >> 63 == 1 {
+        f64::from_bits(bits & !(1 << 63))
+    } else {
+        f64::from_bits(!bits)
+    }
+}
+
+/// One heap entry: the cost, the first vertex and the pair's id, 16 bytes, so that the
+/// four children of a node fill one cache line (see [`Line`]). The second vertex, only
+/// needed on a tie of the first two, is in the id's [`Slot`].
+#[derive(Clone, Copy, Debug, Default)]
+struct Entry {
+    /// [`cost_bits`] of the cost.
+    cost: u64,
+    /// The [`Numbering`] of the vertex the push named first.
+    first: u32,
+    /// The pair's id: an edge's slot index, or a virtual pair's id past the edges.
+    id: u32,
+}
+
+/// What the queue keeps per id, 8 bytes: where its entry is and its second vertex.
+#[derive(Clone, Copy, Debug)]
+struct Slot {
+    /// Heap index of the entry, [`ABSENT`] when not queued.
+    position: u32,
+    /// The [`Numbering`] of the vertex the push named second.
+    second: u32,
+}
+
+const NO_SLOT: Slot = Slot {
+    position: ABSENT,
+    second: 0,
+};
+
+/// The four children of one node, aligned to a cache line: the heap is stored three
+/// entries late, so that the children `4i + 1 ..= 4i + 4` of node `i` are exactly
+/// line `i + 1` and a sift down reads one line per level.
+#[derive(Clone, Copy, Debug, Default)]
+#[repr(align(64))]
+struct Line([Entry; ARITY]);
+
+/// A popped pair.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Popped {
+    /// The cost it was queued with (normalised units).
+    pub cost: f64,
+    /// The vertex the push named first.
+    pub a: VertexKey,
+    /// The other vertex.
+    pub b: VertexKey,
+    /// The edge joining them, `None` for a virtual pair.
+    pub edge: Option<EdgeKey>,
+}
+
+/// Candidate pairs ordered by cost: a 4-ary min-heap, root at index 0, children of `i`
+/// at `ARITY * i + 1 ..= ARITY * i + ARITY` (stored in [`Line`]s), with the heap index
+/// of every id.
+///
+/// Vertices are compared by their [`Numbering`], whose order is the `as_ffi` order of
+/// the keys, so a pair's tie-break is one `u64` (the store gains no vertex while the
+/// queue lives, so the numbering stays valid).
 #[derive(Debug, Default)]
 pub(crate) struct PairQueue {
-    heap: Vec<Candidate>,
+    /// The heap, three entries late (see [`Line`]).
+    lines: Vec<Line>,
+    /// Number of entries in the heap.
+    len: usize,
+    /// Position and second vertex of every id.
+    slots: Vec<Slot>,
+    /// Vertex numbers for the tie-break.
+    vertices: Numbering<VertexKey>,
+    /// The edge of each edge id (= its slot index, which is also its number here).
+    edges: Numbering<EdgeKey>,
+    /// Ids below this are edges.
+    edge_slots: usize,
+    /// Ids of the virtual pairs, by their two vertex keys (`as_ffi`, smaller first).
+    /// Only ever looked up, never iterated, so its hash order cannot reach an output.
+    virtual_ids: HashMap<(u64, u64), u32>,
+    /// Virtual-pair ids free for reuse.
+    free_ids: Vec<u32>,
 }
 
 impl PairQueue {
-    /// An empty queue with room for `capacity` entries.
-    pub fn with_capacity(capacity: usize) -> Self {
-        Self {
-            heap: Vec::with_capacity(capacity),
+    /// An empty queue for the pairs of `store`'s vertices and edges.
+    pub fn new(store: &MeshStore) -> Self {
+        let edge_slots = store.edges().map(|e| slot(e) + 1).max().unwrap_or(0);
+        let mut edges = Numbering::new(store.edges());
+        if let Numbering::Ranked { keys, .. } = &mut edges {
+            // Edge numbers are slot indices, not ranks: the id of an edge is its slot.
+            let mut by_slot = vec![EdgeKey::null(); edge_slots];
+            for &e in keys.iter() {
+                by_slot[slot(e)] = e;
+            }
+            *keys = by_slot;
+        }
+        PairQueue {
+            lines: Vec::with_capacity(store.edge_count() / ARITY + 2),
+            len: 0,
+            slots: vec![NO_SLOT; edge_slots],
+            vertices: Numbering::new(store.vertices()),
+            edges,
+            edge_slots,
+            virtual_ids: HashMap::new(),
+            free_ids: Vec::new(),
         }
     }
 
-    /// Queues a candidate.
-    pub fn push(&mut self, candidate: Candidate) {
-        self.heap.push(candidate);
-        self.sift_up(self.heap.len() - 1);
-    }
-
-    /// Number of queued entries, stale ones included.
+    /// Number of queued pairs.
+    #[cfg(test)]
     pub fn len(&self) -> usize {
-        self.heap.len()
+        self.len
     }
 
-    /// Keeps only the entries for which `keep` is true (used to drop stale entries
-    /// when they outnumber the live ones, so the heap stays proportional to the mesh).
-    pub fn retain(&mut self, mut keep: impl FnMut(&Candidate) -> bool) {
-        self.heap.retain(|c| keep(c));
-        // Bottom-up heap construction: O(n).
-        for i in (0..self.heap.len().div_ceil(ARITY)).rev() {
-            self.sift_down(i);
+    /// The entry at heap index `i`.
+    #[inline]
+    fn get(&self, i: usize) -> Entry {
+        let p = i + ARITY - 1;
+        self.lines[p / ARITY].0[p % ARITY]
+    }
+
+    /// Writes the entry at heap index `i` and records its position.
+    #[inline]
+    fn set(&mut self, i: usize, entry: Entry) {
+        let p = i + ARITY - 1;
+        self.lines[p / ARITY].0[p % ARITY] = entry;
+        self.slots[entry.id as usize].position = i as u32;
+    }
+
+    /// Whether `x` pops before `y` (two entries of different pairs).
+    #[inline]
+    fn before(&self, x: &Entry, y: &Entry) -> bool {
+        match (x.cost, x.first).cmp(&(y.cost, y.first)) {
+            std::cmp::Ordering::Less => true,
+            std::cmp::Ordering::Greater => false,
+            std::cmp::Ordering::Equal => {
+                self.slots[x.id as usize].second < self.slots[y.id as usize].second
+            }
         }
     }
 
-    /// Removes and returns the cheapest candidate (stale or not).
-    pub fn pop(&mut self) -> Option<Candidate> {
-        let last = self.heap.pop()?;
-        if self.heap.is_empty() {
-            return Some(last);
+    /// The id of the pair `a`–`b` joined by `edge`, or of the virtual pair `a`–`b`
+    /// (handed out on first use).
+    fn id(&mut self, a: VertexKey, b: VertexKey, edge: Option<EdgeKey>) -> u32 {
+        if let Some(e) = edge {
+            debug_assert_eq!(self.edges.key(slot(e) as u32), e);
+            return slot(e) as u32;
         }
-        let top = std::mem::replace(&mut self.heap[0], last);
-        self.sift_down(0);
-        Some(top)
+        let next = self.slots.len() as u32;
+        let free = &mut self.free_ids;
+        let slots = &mut self.slots;
+        *self
+            .virtual_ids
+            .entry(virtual_key(a, b))
+            .or_insert_with(|| {
+                free.pop().unwrap_or_else(|| {
+                    slots.push(NO_SLOT);
+                    next
+                })
+            })
     }
 
-    /// Moves the entry at `i` up until its parent pops before it.
-    fn sift_up(&mut self, mut i: usize) {
-        let moving = self.heap[i];
+    /// Queues the pair `a`–`b` (joined by `edge`, or virtual) at `cost`, or, when it is
+    /// queued already, gives it this cost and names `a` first from now on.
+    pub fn push(&mut self, cost: f64, a: VertexKey, b: VertexKey, edge: Option<EdgeKey>) {
+        let id = self.id(a, b, edge);
+        let entry = Entry {
+            cost: cost_bits(cost),
+            first: self.vertices.number(a),
+            id,
+        };
+        let slot = &mut self.slots[id as usize];
+        slot.second = self.vertices.number(b);
+        match slot.position {
+            ABSENT => {
+                self.len += 1;
+                if (self.len + ARITY - 2) / ARITY >= self.lines.len() {
+                    self.lines.push(Line::default());
+                }
+                self.sift_up(self.len - 1, entry);
+            }
+            i => self.replace(i as usize, entry),
+        }
+    }
+
+    /// Takes the pair joined by `edge` out of the queue, if it is there.
+    pub fn remove_edge(&mut self, edge: EdgeKey) {
+        let id = slot(edge);
+        debug_assert_eq!(self.edges.key(id as u32), edge);
+        self.remove_id(id);
+    }
+
+    /// Takes the virtual pair `a`–`b` out of the queue, if it is there, and frees its id.
+    pub fn remove_virtual(&mut self, a: VertexKey, b: VertexKey) {
+        if let Some(id) = self.virtual_ids.remove(&virtual_key(a, b)) {
+            self.remove_id(id as usize);
+            self.free_ids.push(id);
+        }
+    }
+
+    /// Removes and returns the cheapest pair.
+    pub fn pop(&mut self) -> Option<Popped> {
+        if self.len == 0 {
+            return None;
+        }
+        let top = self.get(0);
+        self.remove_at(0);
+        Some(Popped {
+            cost: cost_from_bits(top.cost),
+            a: self.vertices.key(top.first),
+            b: self.vertices.key(self.slots[top.id as usize].second),
+            edge: ((top.id as usize) < self.edge_slots).then(|| self.edges.key(top.id)),
+        })
+    }
+
+    fn remove_id(&mut self, id: usize) {
+        match self.slots[id].position {
+            ABSENT => {}
+            i => self.remove_at(i as usize),
+        }
+    }
+
+    /// Removes the entry at heap index `i`.
+    fn remove_at(&mut self, i: usize) {
+        let removed = self.get(i).id;
+        self.len -= 1;
+        if i < self.len {
+            let last = self.get(self.len);
+            self.replace(i, last);
+        }
+        self.slots[removed as usize].position = ABSENT;
+    }
+
+    /// Puts `entry` at heap index `i` in place of what was there, then restores the
+    /// heap order.
+    fn replace(&mut self, i: usize, entry: Entry) {
+        if self.before(&entry, &self.get(i)) {
+            self.sift_up(i, entry);
+        } else {
+            self.sift_down(i, entry);
+        }
+    }
+
+    /// Places `moving` at or above the hole at `i`, until its parent pops before it.
+    fn sift_up(&mut self, mut i: usize, moving: Entry) {
         while i > 0 {
             let parent = (i - 1) / ARITY;
-            if self.heap[parent] >= moving {
+            let above = self.get(parent);
+            if !self.before(&moving, &above) {
                 break;
             }
-            self.heap[i] = self.heap[parent];
+            self.set(i, above);
             i = parent;
         }
-        self.heap[i] = moving;
+        self.set(i, moving);
     }
 
-    /// Moves the entry at `i` down until none of its children pops before it.
-    fn sift_down(&mut self, mut i: usize) {
-        let len = self.heap.len();
-        let moving = self.heap[i];
+    /// Places `moving` at or below the hole at `i`, until no child pops before it.
+    fn sift_down(&mut self, mut i: usize, moving: Entry) {
+        let len = self.len;
         loop {
             let first = ARITY * i + 1;
             if first >= len {
                 break;
             }
-            let mut best = first;
-            for child in first + 1..(first + ARITY).min(len) {
-                if self.heap[child] > self.heap[best] {
-                    best = child;
+            // The children are line i + 1.
+            let children = &self.lines[i + 1].0;
+            let count = (len - first).min(ARITY);
+            let mut best = 0;
+            for c in 1..count {
+                if self.before(&children[c], &children[best]) {
+                    best = c;
                 }
             }
-            if self.heap[best] <= moving {
+            let below = children[best];
+            if !self.before(&below, &moving) {
                 break;
             }
-            self.heap[i] = self.heap[best];
-            i = best;
+            self.set(i, below);
+            i = first + best;
         }
-        self.heap[i] = moving;
+        self.set(i, moving);
     }
+}
+
+/// The map key of the virtual pair `a`–`b`, the same either way round.
+fn virtual_key(a: VertexKey, b: VertexKey) -> (u64, u64) {
+    let (a, b) = (a.data().as_ffi(), b.data().as_ffi());
+    (a.min(b), a.max(b))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use slotmap::SlotMap;
+    use crate::IndexedMesh;
+
+    #[test]
+    fn four_entries_fill_one_cache_line() {
+        assert_eq!(std::mem::size_of::<Entry>(), 16);
+        assert_eq!(std::mem::size_of::<Line>(), 64);
+        assert_eq!(std::mem::align_of::<Line>(), 64);
+    }
+
+    #[test]
+    fn cost_bits_keep_the_total_order() {
+        let costs = [
+            f64::NEG_INFINITY,
+            -1.0,
+            -0.0,
+            0.0,
+            1e-300,
+            0.5,
+            1.0,
+            f64::INFINITY,
+            f64::NAN,
+        ];
+        for x in costs {
+            assert_eq!(cost_from_bits(cost_bits(x)).to_bits(), x.to_bits());
+            for y in costs {
+                assert_eq!(cost_bits(x).cmp(&cost_bits(y)), x.total_cmp(&y), "{x} {y}");
+            }
+        }
+    }
+
+    /// Keys of several versions (a slot freed and taken again) are ranked in `as_ffi`
+    /// order; keys of one version are numbered by slot. Both convert back.
+    #[test]
+    fn numbering_follows_the_key_order() {
+        let mut map: slotmap::SlotMap<VertexKey, ()> = slotmap::SlotMap::with_key();
+        let first: Vec<VertexKey> = (0..5).map(|_| map.insert(())).collect();
+        let one = Numbering::new(map.keys());
+        assert!(matches!(one, Numbering::OneVersion(1)));
+        for &k in &first {
+            let n = one.number(k);
+            assert_eq!(n as usize, slot(k));
+            assert_eq!(one.key(n), k);
+        }
+        assert!(first
+            .windows(2)
+            .all(|w| one.number(w[0]) < one.number(w[1])));
+        map.remove(first[1]);
+        map.remove(first[3]);
+        let again = map.insert(()); // slot 3, version 3
+        let keys: Vec<VertexKey> = map.keys().collect();
+        let ranked = Numbering::new(keys.iter().copied());
+        assert!(matches!(ranked, Numbering::Ranked { .. }));
+        let mut sorted = keys.clone();
+        sorted.sort_by_key(|k| k.data().as_ffi());
+        assert_eq!(sorted.last(), Some(&again));
+        for (n, &k) in sorted.iter().enumerate() {
+            assert_eq!(ranked.number(k), n as u32);
+            assert_eq!(ranked.key(n as u32), k);
+        }
+    }
+
+    /// A strip of `n` triangles: vertices `0..n + 2`, edges between neighbours.
+    fn strip(n: u32) -> (MeshStore, Vec<VertexKey>) {
+        let positions = (0..n + 2)
+            .map(|i| [f64::from(i / 2), f64::from(i % 2), 0.0])
+            .collect();
+        let faces = (0..n).map(|i| [i, i + 1, i + 2]).collect();
+        let mesh = IndexedMesh::new(positions, faces);
+        MeshStore::from_mesh(&mesh).expect("a valid strip")
+    }
 
     #[test]
     fn pops_cheapest_first_with_key_tie_break() {
-        let mut keys: SlotMap<VertexKey, ()> = SlotMap::with_key();
-        let v: Vec<VertexKey> = (0..4).map(|_| keys.insert(())).collect();
-        let mut q = PairQueue::with_capacity(4);
-        let c = |cost, a: VertexKey, b: VertexKey| Candidate {
-            cost,
-            a,
-            b,
-            stamp_a: 0,
-            stamp_b: 0,
-        };
-        q.push(c(2.0, v[0], v[1]));
-        q.push(c(1.0, v[2], v[3]));
-        q.push(c(1.0, v[1], v[2]));
-        q.push(c(0.5, v[3], v[0]));
+        let (store, v) = strip(2);
+        let e = |a: usize, b: usize| store.find_edge(v[a], v[b]);
+        let mut q = PairQueue::new(&store);
+        q.push(2.0, v[0], v[1], e(0, 1));
+        q.push(1.0, v[2], v[3], e(2, 3));
+        q.push(1.0, v[1], v[2], e(1, 2));
+        q.push(0.5, v[3], v[0], None);
         let order: Vec<(f64, VertexKey)> = std::iter::from_fn(|| q.pop())
             .map(|c| (c.cost, c.a))
             .collect();
@@ -183,14 +487,19 @@ mod tests {
         );
     }
 
-    /// Many entries with repeated costs, some dropped by `retain` halfway: every pop
-    /// is the smallest remaining entry in (cost, keys) order, as a sorted list says.
+    /// Pushes (new pairs and updates, either way round), removals of edges and of
+    /// virtual pairs, and pops, against a model that keeps one `(cost, a, b)` per pair
+    /// and pops its smallest: every pop agrees, and so does the final length.
     #[test]
-    fn pops_in_sorted_order_after_pushes_and_retain() {
-        let mut keys: SlotMap<VertexKey, ()> = SlotMap::with_key();
-        let v: Vec<VertexKey> = (0..50).map(|_| keys.insert(())).collect();
-        let mut q = PairQueue::with_capacity(0);
-        let mut model = Vec::new();
+    fn matches_a_sorted_model_through_updates_and_removals() {
+        let (store, v) = strip(60);
+        let edges: Vec<EdgeKey> = store.edges().collect();
+        let mut q = PairQueue::new(&store);
+        // Model: pair name -> (cost, a, b); a pair is an edge index or a virtual (i, j).
+        let mut model: std::collections::BTreeMap<
+            (usize, usize, bool),
+            (f64, VertexKey, VertexKey),
+        > = Default::default();
         let mut seed = 12345u64;
         let mut next = || {
             seed = seed
@@ -198,34 +507,67 @@ mod tests {
                 .wrapping_add(1442695040888963407);
             (seed >> 33) as usize
         };
-        for round in 0..2 {
-            for _ in 0..1000 {
-                let c = Candidate {
-                    cost: (next() % 20) as f64 * 0.5,
-                    a: v[next() % 50],
-                    b: v[next() % 50],
-                    stamp_a: round,
-                    stamp_b: 0,
-                };
-                q.push(c);
-                model.push(c);
+        let key = |c: &(f64, VertexKey, VertexKey)| {
+            (c.0.to_bits(), c.1.data().as_ffi(), c.2.data().as_ffi())
+        };
+        for _ in 0..5000 {
+            match next() % 6 {
+                0..=2 => {
+                    let cost = (next() % 20) as f64 * 0.25;
+                    if next() % 3 == 0 {
+                        let (i, j) = (next() % v.len(), next() % v.len());
+                        if i == j || store.find_edge(v[i], v[j]).is_some() {
+                            continue;
+                        }
+                        let (a, b) = if next() % 2 == 0 {
+                            (v[i], v[j])
+                        } else {
+                            (v[j], v[i])
+                        };
+                        q.push(cost, a, b, None);
+                        model.insert((i.min(j), i.max(j), true), (cost, a, b));
+                    } else {
+                        let k = next() % edges.len();
+                        let [x, y] = store.edge_vertices(edges[k]);
+                        let (a, b) = if next() % 2 == 0 { (x, y) } else { (y, x) };
+                        q.push(cost, a, b, Some(edges[k]));
+                        model.insert((k, 0, false), (cost, a, b));
+                    }
+                }
+                3 => {
+                    let k = next() % edges.len();
+                    q.remove_edge(edges[k]);
+                    model.remove(&(k, 0, false));
+                }
+                4 => {
+                    let (i, j) = (next() % v.len(), next() % v.len());
+                    q.remove_virtual(v[j], v[i]);
+                    model.remove(&(i.min(j), i.max(j), true));
+                }
+                _ => {
+                    let expected = model
+                        .iter()
+                        .min_by(|x, y| {
+                            x.1 .0
+                                .total_cmp(&y.1 .0)
+                                .then(key(x.1).1.cmp(&key(y.1).1))
+                                .then(key(x.1).2.cmp(&key(y.1).2))
+                        })
+                        .map(|(name, c)| (*name, *c));
+                    let popped = q.pop();
+                    match (expected, popped) {
+                        (None, None) => {}
+                        (Some((name, (cost, a, b))), Some(p)) => {
+                            assert_eq!((p.cost, p.a, p.b), (cost, a, b));
+                            let edge = (!name.2).then(|| edges[name.0]);
+                            assert_eq!(p.edge, edge);
+                            model.remove(&name);
+                        }
+                        (e, p) => panic!("model {e:?}, queue {p:?}"),
+                    }
+                }
             }
-            let keep = |c: &Candidate| c.a != v[7] && c.cost != 3.0;
-            q.retain(keep);
-            model.retain(keep);
-            for _ in 0..300 {
-                let popped = q.pop().map(|c| (c.cost, c.tie_key()));
-                model.sort(); // cheapest last: the order is reversed
-                let expected = model.pop().map(|c| (c.cost, c.tie_key()));
-                assert_eq!(popped, expected);
-            }
+            assert_eq!(q.len(), model.len());
         }
-        assert_eq!(q.len(), model.len());
-        model.sort();
-        while let Some(c) = q.pop() {
-            let expected = model.pop().map(|c| (c.cost, c.tie_key()));
-            assert_eq!(Some((c.cost, c.tie_key())), expected);
-        }
-        assert!(model.is_empty());
     }
 }

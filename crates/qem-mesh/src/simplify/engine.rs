@@ -8,14 +8,14 @@ use super::orientation::InputSurface;
 use super::report::{SimplifyError, StopReason};
 use crate::clean::min_double_area;
 use crate::pairs::grid::{virtual_pairs, GridOptions};
-use crate::queue::{Candidate, PairQueue};
+use crate::queue::PairQueue;
 use crate::store::{EdgeKey, FaceKey, MeshStore, VertexKey};
 use crate::IndexedMesh;
 use qem_core::{
     endpoint_placement, optimal_placement, unit_normal_and_area, DVec3, Frame, Placement,
     PlacementRule, Quadric,
 };
-use slotmap::SecondaryMap;
+use slotmap::{Key, SecondaryMap};
 use smallvec::SmallVec;
 use std::collections::HashSet;
 
@@ -37,16 +37,12 @@ const OBSERVER_INTERVAL: usize = 4096;
 /// each other. 32 is the smallest factor tried that leaves none at 0.1.
 const ORIENTATION_PENALTY: f64 = 32.0;
 
-/// When the queue holds more than this many entries per live pair, stale entries are
-/// dropped. Why 2: a rebuild costs O(queue) and happens after at least as many pushes,
-/// so it adds O(1) amortised per push while keeping the heap within 2x of minimal.
-const STALE_REBUILD_FACTOR: usize = 2;
-
-/// Whether a queued pair still describes the two vertices as they are now.
-fn is_current(state: &SecondaryMap<VertexKey, VertexState>, c: &Candidate) -> bool {
-    match (state.get(c.a), state.get(c.b)) {
-        (Some(sa), Some(sb)) => sa.stamp == c.stamp_a && sb.stamp == c.stamp_b,
-        _ => false,
+/// A pair's two vertices, smaller key first: one spelling per pair.
+fn ordered_pair(a: VertexKey, b: VertexKey) -> (VertexKey, VertexKey) {
+    if a < b {
+        (a, b)
+    } else {
+        (b, a)
     }
 }
 
@@ -59,12 +55,107 @@ pub(super) struct VertexState {
     pub quadric: Quadric,
     /// The position in normalised units.
     pub position: DVec3,
-    /// Bumped whenever the quadric or position changes; see [`crate::queue`].
-    pub stamp: u32,
     /// Never moves, never disappears.
     pub locked: bool,
     /// Index in the cleaned mesh (for [`Contraction`] events).
     pub index: u32,
+}
+
+/// One vertex's state and the version of the key it belongs to (0: no vertex), padded
+/// and aligned to exactly two cache lines. Why: `SecondaryMap`'s 120-byte slots start
+/// anywhere in a line, so reading a quadric and position touched three lines about
+/// half the time; the placement reads two vertices' states per queued pair and the
+/// checks read the positions of every corner around a pair.
+#[derive(Clone, Debug, Default)]
+#[repr(align(64))]
+struct StateSlot {
+    state: VertexState,
+    version: u32,
+}
+
+/// The [`VertexState`] of every live vertex, by the slot index of its key: the part of
+/// `SecondaryMap`'s interface that the loop uses, over [`StateSlot`]s. A key whose
+/// version does not match (a removed vertex) has no state, as in a `SecondaryMap`.
+#[derive(Clone, Debug, Default)]
+pub(super) struct VertexStates {
+    slots: Vec<StateSlot>,
+}
+
+/// Slot index and version of a key.
+fn split_key(v: VertexKey) -> (usize, u32) {
+    let ffi = v.data().as_ffi();
+    (ffi as u32 as usize, (ffi >> 32) as u32)
+}
+
+impl VertexStates {
+    pub fn with_capacity(capacity: usize) -> Self {
+        VertexStates {
+            slots: Vec::with_capacity(capacity + 1),
+        }
+    }
+
+    pub fn get(&self, v: VertexKey) -> Option<&VertexState> {
+        let (i, version) = split_key(v);
+        self.slots
+            .get(i)
+            .filter(|s| s.version == version)
+            .map(|s| &s.state)
+    }
+
+    pub fn get_mut(&mut self, v: VertexKey) -> Option<&mut VertexState> {
+        let (i, version) = split_key(v);
+        self.slots
+            .get_mut(i)
+            .filter(|s| s.version == version)
+            .map(|s| &mut s.state)
+    }
+
+    pub fn contains_key(&self, v: VertexKey) -> bool {
+        self.get(v).is_some()
+    }
+
+    pub fn insert(&mut self, v: VertexKey, state: VertexState) {
+        let (i, version) = split_key(v);
+        if self.slots.len() <= i {
+            self.slots.resize_with(i + 1, StateSlot::default);
+        }
+        self.slots[i] = StateSlot { state, version };
+    }
+
+    pub fn remove(&mut self, v: VertexKey) {
+        let (i, version) = split_key(v);
+        if let Some(s) = self.slots.get_mut(i).filter(|s| s.version == version) {
+            s.version = 0;
+        }
+    }
+
+    /// The states of the live vertices, in slot order.
+    pub fn values(&self) -> impl Iterator<Item = &VertexState> {
+        self.slots
+            .iter()
+            .filter(|s| s.version != 0)
+            .map(|s| &s.state)
+    }
+}
+
+impl std::ops::Index<VertexKey> for VertexStates {
+    type Output = VertexState;
+
+    fn index(&self, v: VertexKey) -> &VertexState {
+        match self.get(v) {
+            Some(s) => s,
+            None => panic!("no state for vertex {v:?}"),
+        }
+    }
+}
+
+impl std::ops::IndexMut<VertexKey> for VertexStates {
+    fn index_mut(&mut self, v: VertexKey) -> &mut VertexState {
+        match self.get_mut(v) {
+            Some(s) => s,
+            None => panic!("no state for vertex {v:?}"),
+        }
+    }
 }
 
 /// What the report counts, accumulated over the run.
@@ -136,7 +227,7 @@ pub(super) struct Settings {
 pub(super) struct Engine {
     pub store: MeshStore,
     pub frame: Frame,
-    pub state: SecondaryMap<VertexKey, VertexState>,
+    pub state: VertexStates,
     queue: PairQueue,
     pub settings: Settings,
     pub counters: Counters,
@@ -154,10 +245,13 @@ pub(super) struct Engine {
     pub face_scratch: Vec<FaceKey>,
     /// The input surface for the orientation check; `None` when the check is off.
     pub input_surface: Option<InputSurface>,
-    /// Queued entries (pair and stamps) that failed the orientation check and were
-    /// queued again at [`ORIENTATION_PENALTY`]: when one pops while current, the check
-    /// is waived. Only looked up, never iterated, so its order cannot matter.
-    orientation_waived: HashSet<(VertexKey, VertexKey, u32, u32)>,
+    /// Pairs (smaller key first) that failed the orientation check and were queued
+    /// again at [`ORIENTATION_PENALTY`], and not re-costed since: when one pops, the
+    /// check is waived (its cost already carries the penalty). Only looked up, never
+    /// iterated, so its order cannot matter.
+    orientation_waived: HashSet<(VertexKey, VertexKey)>,
+    /// Reused buffer of the edges of the vertex being removed.
+    b_edges: Vec<EdgeKey>,
 }
 
 impl Engine {
@@ -181,8 +275,8 @@ impl Engine {
             any_locked: false,
         };
         Engine {
-            state: SecondaryMap::with_capacity(store.vertex_count()),
-            queue: PairQueue::with_capacity(store.edge_count() * 2),
+            state: VertexStates::with_capacity(store.vertex_count()),
+            queue: PairQueue::new(&store),
             exact: (options.quadrics == QuadricMode::Exact).then(|| ExactQuadrics::new(&store)),
             original_normals: SecondaryMap::with_capacity(store.face_count()),
             partners: SecondaryMap::new(),
@@ -194,6 +288,7 @@ impl Engine {
             face_scratch: Vec::new(),
             input_surface: None,
             orientation_waived: HashSet::new(),
+            b_edges: Vec::new(),
         }
     }
 
@@ -428,15 +523,16 @@ impl Engine {
 
     fn push_pair(&mut self, a: VertexKey, b: VertexKey, ab: Option<EdgeKey>) {
         let (placed, _) = self.place(a, b, ab);
-        self.queue.push(Candidate {
-            cost: placed.cost,
-            a,
-            b,
-            stamp_a: self.state[a].stamp,
-            stamp_b: self.state[b].stamp,
-        });
+        self.queue.push(placed.cost, a, b, ab);
+        // Re-costed: a penalty from an earlier orientation refusal no longer applies.
+        if !self.orientation_waived.is_empty() {
+            self.orientation_waived.remove(&ordered_pair(a, b));
+        }
     }
 
+    // Out of line (it runs once per level, so this costs nothing) so that profilers
+    // can count the loop alone, e.g. `valgrind --toggle-collect='*Engine::run*'`.
+    #[inline(never)]
     pub fn run(
         &mut self,
         target: usize,
@@ -452,9 +548,6 @@ impl Engine {
             let Some(candidate) = self.queue.pop() else {
                 break StopReason::NoValidPair;
             };
-            if !is_current(&self.state, &candidate) {
-                continue;
-            }
             let (mut a, mut b) = (candidate.a, candidate.b);
             // Cheapest checks first: locks are two flags.
             let (locked_a, locked_b) = (self.state[a].locked, self.state[b].locked);
@@ -466,7 +559,10 @@ impl Engine {
                 // The locked vertex is the one that stays.
                 std::mem::swap(&mut a, &mut b);
             }
-            let ab = self.store.find_edge(a, b);
+            // The queue keeps every entry current (see `contract`), so the edge it
+            // was queued with still joins the two.
+            let ab = candidate.edge;
+            debug_assert_eq!(ab, self.store.find_edge(a, b));
             // Never contract the last faces away: the output must keep a triangle.
             let shared_faces = ab.map_or(0, |e| self.store.fan(e).len());
             if shared_faces >= self.store.face_count() {
@@ -483,28 +579,22 @@ impl Engine {
             } else {
                 self.world_position(&placed, a)
             };
-            let waived = !self.orientation_waived.is_empty()
-                && self.orientation_waived.remove(&(
-                    candidate.a,
-                    candidate.b,
-                    candidate.stamp_a,
-                    candidate.stamp_b,
-                ));
+            let pair = ordered_pair(candidate.a, candidate.b);
+            let waived =
+                !self.orientation_waived.is_empty() && self.orientation_waived.remove(&pair);
             if let Err(why) = self.check(a, b, ab, world, !waived) {
                 self.counters.reject(why);
                 if why == Rejection::Orientation {
                     // Not refused for good: queued again at a penalty, so it is taken
                     // only when every alternative costs more (see ORIENTATION_PENALTY).
-                    self.orientation_waived.insert((
+                    // Same names in the same order: the tie-break stays the push's.
+                    self.orientation_waived.insert(pair);
+                    self.queue.push(
+                        placed.cost * ORIENTATION_PENALTY,
                         candidate.a,
                         candidate.b,
-                        candidate.stamp_a,
-                        candidate.stamp_b,
-                    ));
-                    self.queue.push(Candidate {
-                        cost: placed.cost * ORIENTATION_PENALTY,
-                        ..candidate
-                    });
+                        candidate.edge,
+                    );
                 }
                 continue;
             }
@@ -522,17 +612,6 @@ impl Engine {
             });
             if options.validate_each_contraction {
                 self.store.validate().map_err(SimplifyError::Internal)?;
-            }
-
-            // Each contraction queues a fresh entry per neighbour and leaves the old
-            // ones stale; once stale entries dominate, drop them in one O(n) pass so
-            // the heap (and every pop) stays proportional to the live pairs.
-            if self.queue.len()
-                > STALE_REBUILD_FACTOR * (self.store.edge_count() + self.counters.virtual_pairs)
-                    + 1024
-            {
-                let state = &self.state;
-                self.queue.retain(|c| is_current(state, c));
             }
 
             since_report += 1;
@@ -581,8 +660,23 @@ impl Engine {
         } else {
             self.counters.virtual_contractions += 1;
         }
-        // Both keys are live (checked by is_current) and distinct (pairs are built from
-        // edges and from distinct grid points), so contraction cannot fail.
+        // The queue's pairs of `b` all go: its edges either move to `a` (and are re-queued
+        // below under the same id) or merge away (removed after the contraction), and
+        // its virtual pairs end with it. `a`'s virtual pairs are dropped too and the
+        // current ones re-queued below, since merging partners may turn one into an edge.
+        let mut b_edges = std::mem::take(&mut self.b_edges);
+        b_edges.clear();
+        b_edges.extend_from_slice(self.store.star(b));
+        for v in [a, b] {
+            if let Some(partners) = self.partners.get(v) {
+                for &p in partners {
+                    self.queue.remove_virtual(v, p);
+                }
+            }
+        }
+        // Both keys are live (the queue holds only pairs of live vertices) and distinct
+        // (pairs are built from edges and from distinct grid points), so contraction
+        // cannot fail.
         let contracted = match &mut self.exact {
             Some(exact) => exact.contract(&mut self.store, a, b, ab, world.to_array()),
             None => self
@@ -591,8 +685,15 @@ impl Engine {
                 .map(|_| ()),
         };
         if contracted.is_err() {
+            self.b_edges = b_edges;
             return;
         }
+        for &e in &b_edges {
+            if !self.store.contains_edge(e) {
+                self.queue.remove_edge(e);
+            }
+        }
+        self.b_edges = b_edges;
 
         self.state.remove(b);
         if !self.partners.is_empty() {
@@ -601,7 +702,6 @@ impl Engine {
         let sa = &mut self.state[a];
         sa.quadric = q;
         sa.position = self.frame.to_normalized(world);
-        sa.stamp = sa.stamp.wrapping_add(1);
 
         // Re-cost every pair around the new vertex.
         let mut neighbours = std::mem::take(&mut self.scratch);
@@ -664,5 +764,41 @@ impl Engine {
                     .is_some_and(|was| now.dot(*was) < 0.0)
             })
             .count()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use slotmap::SlotMap;
+
+    /// `VertexStates` answers as a `SecondaryMap` would: by key, versions included, and
+    /// each record is two whole cache lines.
+    #[test]
+    fn vertex_states_behave_like_a_secondary_map() {
+        assert_eq!(std::mem::size_of::<StateSlot>(), 128);
+        let mut keys: SlotMap<VertexKey, ()> = SlotMap::with_key();
+        let v: Vec<VertexKey> = (0..4).map(|_| keys.insert(())).collect();
+        let mut states = VertexStates::with_capacity(2);
+        for (i, &k) in v.iter().enumerate().skip(1) {
+            let state = VertexState {
+                index: i as u32,
+                ..VertexState::default()
+            };
+            states.insert(k, state);
+        }
+        assert!(!states.contains_key(v[0]));
+        assert_eq!(states[v[2]].index, 2);
+        states[v[2]].locked = true;
+        assert!(states.get(v[2]).is_some_and(|s| s.locked));
+        states.remove(v[1]);
+        assert!(states.get(v[1]).is_none());
+        let indices: Vec<u32> = states.values().map(|s| s.index).collect();
+        assert_eq!(indices, vec![2, 3]);
+        // A key of another version in a used slot has no state.
+        keys.remove(v[3]);
+        let reused = keys.insert(());
+        assert!(states.get(reused).is_none());
+        assert!(states.get_mut(reused).is_none());
     }
 }

@@ -263,6 +263,19 @@ impl MeshStore {
             }
         }
 
+        // a's neighbours and the edge to each, read once: steps 2 and 3 ask for a's
+        // edge to a neighbour of b per face and per edge of b, and a's star does not
+        // change until step 3 appends to it (edges to vertices not listed here).
+        let mut links = std::mem::take(&mut self.scratch.links);
+        links.clear();
+        links.extend(
+            self.vertices[a]
+                .star
+                .iter()
+                .filter_map(|&e| self.other_vertex(e, a).map(|x| (x, e))),
+        );
+        let edge_to = |x: VertexKey| links.iter().find(|l| l.0 == x).map(|l| l.1);
+
         // Step 2: faces of b move to a, or merge into a face of a.
         self.faces_of_vertex(b, &mut faces);
         for &f in &faces {
@@ -272,7 +285,15 @@ impl MeshStore {
             };
             let x = face.vertices[(slot + 1) % 3];
             let y = face.vertices[(slot + 2) % 3];
-            if let Some(kept) = self.find_face(a, x, y) {
+            // The face a x y, if any (as `find_face`, with a's edge to x from `links`).
+            let kept = edge_to(x).and_then(|ax| {
+                self.edges[ax]
+                    .fan
+                    .iter()
+                    .copied()
+                    .find(|&g| self.faces[g].vertices.contains(&y))
+            });
+            if let Some(kept) = kept {
                 self.remove_face(f);
                 outcome.faces_merged += 1;
                 if let Some(log) = log.as_deref_mut() {
@@ -290,7 +311,7 @@ impl MeshStore {
             let Some(x) = self.other_vertex(e, b) else {
                 continue;
             };
-            match self.find_edge(a, x) {
+            match edge_to(x) {
                 Some(keep) => {
                     let moved = std::mem::take(&mut self.edges[e].fan);
                     for &f in &moved {
@@ -320,6 +341,7 @@ impl MeshStore {
 
         self.scratch.faces = faces;
         self.scratch.edges = edges;
+        self.scratch.links = links;
         outcome
     }
 

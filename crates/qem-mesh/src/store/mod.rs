@@ -97,6 +97,8 @@ struct Face {
 struct Scratch {
     faces: Vec<FaceKey>,
     edges: Vec<EdgeKey>,
+    /// The neighbours of the kept vertex and the edge to each.
+    links: Vec<(VertexKey, EdgeKey)>,
 }
 
 /// A radial-edge adjacency store for arbitrary triangle complexes.
