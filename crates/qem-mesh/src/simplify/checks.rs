@@ -3,7 +3,7 @@
 
 use super::engine::Engine;
 use crate::clean::cross_underflows;
-use crate::store::{EdgeClass, EdgeKey, VertexClass, VertexKey};
+use crate::store::{EdgeClass, EdgeKey, FaceKey, VertexClass, VertexKey};
 use qem_core::DVec3;
 
 /// Why a contraction was refused (each has a counter in the report).
@@ -64,10 +64,32 @@ impl Engine {
         world: DVec3,
         orientation: bool,
     ) -> Result<(), Rejection> {
-        self.fold_over(a, b, world)?;
+        // The faces around both ends, gathered once for every check that walks them.
+        let mut around = std::mem::take(&mut self.around_scratch);
+        self.store.faces_of_vertex(a, &mut around[0]);
+        self.store.faces_of_vertex(b, &mut around[1]);
+        let verdict = self.check_around(a, b, ab, world, orientation, &around);
+        self.around_scratch = around;
+        verdict
+    }
+
+    /// [`check`](Self::check) with `around` = the faces of `a` and of `b`.
+    fn check_around(
+        &mut self,
+        a: VertexKey,
+        b: VertexKey,
+        ab: Option<EdgeKey>,
+        world: DVec3,
+        orientation: bool,
+        around: &[Vec<FaceKey>; 2],
+    ) -> Result<(), Rejection> {
+        self.fold_over(a, b, world, around)?;
         // In topology mode the link condition below refuses these merges too (its edge
         // half is the same test), so it is not run twice.
-        if ab.is_some() && !self.settings.preserve_topology && self.would_merge_faces(a, b) {
+        if ab.is_some()
+            && !self.settings.preserve_topology
+            && self.would_merge_faces(a, b, &around[0])
+        {
             return Err(Rejection::Merge);
         }
         if self.settings.keep_border_loops {
@@ -84,7 +106,9 @@ impl Engine {
             return Err(Rejection::Locked);
         }
         // Last: the only check that searches outside the neighbourhood.
-        if orientation && self.input_surface.is_some() && !self.faces_agree_with_input(a, b, world)
+        if orientation
+            && self.input_surface.is_some()
+            && !self.faces_agree_with_input(a, b, world, around)
         {
             return Err(Rejection::Orientation);
         }
@@ -114,13 +138,17 @@ impl Engine {
     /// were the last one the output would be empty. Why the sliver test also asks for
     /// "worse than before": an input full of slivers (CAD exports) would otherwise
     /// block every contraction near them, even those that improve them.
-    fn fold_over(&mut self, a: VertexKey, b: VertexKey, world: DVec3) -> Result<(), Rejection> {
+    fn fold_over(
+        &self,
+        a: VertexKey,
+        b: VertexKey,
+        world: DVec3,
+        around: &[Vec<FaceKey>; 2],
+    ) -> Result<(), Rejection> {
         let moved = self.frame.to_normalized(world);
-        let mut faces = std::mem::take(&mut self.face_scratch);
         let mut verdict = Ok(());
-        'vertices: for v in [a, b] {
-            self.store.faces_of_vertex(v, &mut faces);
-            for &f in &faces {
+        'vertices: for faces in around {
+            for &f in faces {
                 let corners = self.store.face_vertices(f);
                 if corners.contains(&a) && corners.contains(&b) {
                     continue; // collapses with the pair
@@ -174,25 +202,28 @@ impl Engine {
                 }
             }
         }
-        self.face_scratch = faces;
         verdict
     }
 
     /// Whether every face that contracting `b` into `a` at `world` moves faces the same
     /// way as the input surface nearest to its new centroid (see
     /// [`super::orientation`]). Faces on both `a` and `b` collapse and are not asked.
-    fn faces_agree_with_input(&mut self, a: VertexKey, b: VertexKey, world: DVec3) -> bool {
+    fn faces_agree_with_input(
+        &mut self,
+        a: VertexKey,
+        b: VertexKey,
+        world: DVec3,
+        around: &[Vec<FaceKey>; 2],
+    ) -> bool {
         let Some(mut surface) = self.input_surface.take() else {
             return true;
         };
         let moved = self.frame.to_normalized(world);
-        let mut faces = std::mem::take(&mut self.face_scratch);
         let mut agree = true;
         // A face seen for the first time borrows the hint of the face checked before it.
         let mut neighbour_hint = None;
-        'vertices: for v in [a, b] {
-            self.store.faces_of_vertex(v, &mut faces);
-            for &f in &faces {
+        'vertices: for faces in around {
+            for &f in faces {
                 let corners = self.store.face_vertices(f);
                 if corners.contains(&a) && corners.contains(&b) {
                     continue;
@@ -210,7 +241,6 @@ impl Engine {
                 }
             }
         }
-        self.face_scratch = faces;
         self.input_surface = Some(surface);
         agree
     }
@@ -224,10 +254,8 @@ impl Engine {
     ///
     /// Cost: for each face of `a` not on `ab`, a search of one fan at `b`; faces on `ab`
     /// are skipped since they collapse.
-    fn would_merge_faces(&mut self, a: VertexKey, b: VertexKey) -> bool {
-        let mut faces = std::mem::take(&mut self.face_scratch);
-        self.store.faces_of_vertex(a, &mut faces);
-        let merge = faces.iter().any(|&f| {
+    fn would_merge_faces(&self, a: VertexKey, b: VertexKey, faces_of_a: &[FaceKey]) -> bool {
+        faces_of_a.iter().any(|&f| {
             let corners = self.store.face_vertices(f);
             if corners.contains(&b) {
                 return false;
@@ -237,9 +265,7 @@ impl Engine {
                 (Some(x), Some(y)) => self.store.find_face(b, x, y).is_some(),
                 _ => false,
             }
-        });
-        self.face_scratch = faces;
-        merge
+        })
     }
 
     /// Whether contracting the edge `ab` keeps every border loop: when both ends are on

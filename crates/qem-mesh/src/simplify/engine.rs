@@ -243,6 +243,8 @@ pub(super) struct Engine {
     scratch: Vec<(VertexKey, Option<EdgeKey>)>,
     /// Reused buffer of the faces around a vertex.
     pub face_scratch: Vec<FaceKey>,
+    /// Reused buffers of the faces around the two ends of the pair being checked.
+    pub around_scratch: [Vec<FaceKey>; 2],
     /// The input surface for the orientation check; `None` when the check is off.
     pub input_surface: Option<InputSurface>,
     /// Pairs (smaller key first) that failed the orientation check and were queued
@@ -286,6 +288,7 @@ impl Engine {
             counters: Counters::default(),
             scratch: Vec::new(),
             face_scratch: Vec::new(),
+            around_scratch: [Vec::new(), Vec::new()],
             input_surface: None,
             orientation_waived: HashSet::new(),
             b_edges: Vec::new(),
