@@ -723,7 +723,7 @@ impl NormalBounds {
             return true;
         }
         let length = length(normal);
-        if !(length > 0.0) || !length.is_finite() {
+        if !length.is_finite() || length <= 0.0 {
             return false;
         }
         let least: f64 = (0..3)
