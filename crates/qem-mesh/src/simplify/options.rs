@@ -193,8 +193,9 @@ pub struct SimplifyOptions {
     /// Default: [`DEFAULT_MIN_TRIANGLE_QUALITY`].
     pub min_triangle_quality: f64,
     /// Refuse a contraction that leaves a moved face facing away from the input surface
-    /// nearest to the face's centroid: every input triangle within 1.5 times the nearest
-    /// one's distance must have a positive dot product with the face's normal. Catches
+    /// nearest to the face's centroid: each of the (up to 8) input triangles nearest to
+    /// it, within 1.5 times the nearest one's distance, must have a positive dot product
+    /// with the face's normal. Catches
     /// what the fold-over check cannot: a large face over a crease or a thin part whose
     /// centroid ends up nearest to the surface's other side. Costs one nearest-triangle
     /// search per moved face, against an index built once over the cleaned input.
