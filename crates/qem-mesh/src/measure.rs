@@ -632,10 +632,15 @@ impl TriangleBvh {
                 for [a, b, c] in &self.corners[start..start + node.count as usize] {
                     let normal = cross(sub(*b, *a), sub(*c, *a));
                     let length = length(normal);
-                    // A zero-area triangle has no direction and no say.
                     if length > 0.0 && length.is_finite() {
                         bounds.grow(normal.map(|x| x / length));
+                    } else if normal != [0.0; 3] {
+                        // A direction whose length under- or overflows (or is NaN):
+                        // any direction, so the subtree is never skipped for it.
+                        bounds.grow([-1.0; 3]);
+                        bounds.grow([1.0; 3]);
                     }
+                    // An exactly zero normal (zero area) has no direction and no say.
                 }
             } else {
                 for child in [node.first as usize, node.first as usize + 1] {
@@ -678,7 +683,10 @@ impl TriangleBvh {
                 let start = node.first as usize;
                 for [a, b, c] in &self.corners[start..start + node.count as usize] {
                     let t = cross(sub(*b, *a), sub(*c, *a));
-                    if dot(t, normal) <= 0.0
+                    // "Not positive", NaN included, exactly as the caller's full test
+                    // asks it (a zero normal has no say there either).
+                    let d = dot(t, normal);
+                    if (d <= 0.0 || d.is_nan())
                         && t != [0.0; 3]
                         && triangle_distance2(p, *a, *b, *c) <= radius2
                     {

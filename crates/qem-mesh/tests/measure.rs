@@ -331,6 +331,54 @@ proptest! {
         }
     }
 
+    /// `any_facing_away` answers exactly what a brute force over every triangle within
+    /// the radius answers, up to the documented widening: it may see a triangle a
+    /// rounding error beyond the radius, never miss one inside it. Normals include NaN
+    /// and tiny ones (the quick test must never accept what the full test refuses).
+    #[test]
+    fn any_facing_away_matches_brute_force(
+        mesh in soup(),
+        queries in proptest::collection::vec(
+            (point(), point(), prop_oneof![Just(0.0), 0.0f64..6.0]),
+            1..20,
+        ),
+        special in prop_oneof![Just(None), Just(Some(f64::NAN)), Just(Some(1e-170))],
+    ) {
+        let bvh = TriangleBvh::new(&mesh);
+        let bounds = bvh.normal_bounds();
+        let cross = |a: [f64; 3], b: [f64; 3]| {
+            [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+        };
+        let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+        let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        for (k, (p, normal, radius)) in queries.into_iter().enumerate() {
+            let normal = match special {
+                Some(x) if k % 2 == 0 => normal.map(|c| c * x),
+                _ => normal,
+            };
+            let count = mesh.triangles.len() as u32;
+            let facing_away_within = |r: f64| {
+                (0..count).any(|i| {
+                    let [a, b, c] = bvh.corners(i);
+                    let t = cross(sub(b, a), sub(c, a));
+                    let d = dot(t, normal);
+                    let q = closest_point_on_triangle(p, a, b, c);
+                    let dist = dot(sub(q, p), sub(q, p)).sqrt();
+                    (d <= 0.0 || d.is_nan()) && t != [0.0; 3] && dist <= r
+                })
+            };
+            let got = bvh.any_facing_away(&bounds, p, radius, normal);
+            if facing_away_within(radius) {
+                prop_assert!(got, "missed a triangle facing away within {radius}");
+            } else if got {
+                prop_assert!(
+                    facing_away_within(radius * (1.0 + 1e-6) + 1e-9),
+                    "found a triangle facing away far beyond {radius}"
+                );
+            }
+        }
+    }
+
     #[test]
     fn the_closest_point_is_on_the_triangle_and_no_farther_than_any_grid_point(
         p in point(), a in point(), b in point(), c in point(),

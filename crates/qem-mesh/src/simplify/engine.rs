@@ -37,6 +37,13 @@ const OBSERVER_INTERVAL: usize = 4096;
 /// each other. 32 is the smallest factor tried that leaves none at 0.1.
 const ORIENTATION_PENALTY: f64 = 32.0;
 
+/// The least cost a penalised pair is queued at, as a distance (normalised units, where
+/// the model's diagonal is at most 2√3): `weight · d²` for the pair's quadric. Why: on a
+/// flat region a pair costs exactly 0, and 32 × 0 would queue it right back at the
+/// front, where it would pop again at once with the check waived; with the floor it
+/// waits behind every pair that moves the surface by less than this.
+const PENALTY_FLOOR_DISTANCE: f64 = 1e-6;
+
 /// A pair's two vertices, smaller key first: one spelling per pair.
 fn ordered_pair(a: VertexKey, b: VertexKey) -> (VertexKey, VertexKey) {
     if a < b {
@@ -592,8 +599,9 @@ impl Engine {
                     // only when every alternative costs more (see ORIENTATION_PENALTY).
                     // Same names in the same order: the tie-break stays the push's.
                     self.orientation_waived.insert(pair);
+                    let floor = q.weight() * PENALTY_FLOOR_DISTANCE * PENALTY_FLOOR_DISTANCE;
                     self.queue.push(
-                        placed.cost * ORIENTATION_PENALTY,
+                        placed.cost.max(floor) * ORIENTATION_PENALTY,
                         candidate.a,
                         candidate.b,
                         candidate.edge,

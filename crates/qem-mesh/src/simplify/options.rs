@@ -195,13 +195,14 @@ pub struct SimplifyOptions {
     /// Refuse a contraction that leaves a moved face facing away from the input surface
     /// nearest to the face's centroid: each of the (up to 8) input triangles nearest to
     /// it, within 1.5 times the nearest one's distance, must have a positive dot product
-    /// with the face's normal. Catches
-    /// what the fold-over check cannot: a large face over a crease or a thin part whose
-    /// centroid ends up nearest to the surface's other side. Costs one nearest-triangle
-    /// search per moved face, against an index built once over the cleaned input.
-    /// A refused pair is not dropped but queued again at 32 times its cost, so it is
-    /// taken only when every alternative costs more: at extreme ratios refusing for good
-    /// would force far costlier contractions elsewhere. Counted in
+    /// with the face's normal (zero-area input triangles have no say). Catches what the
+    /// fold-over check cannot: a large face over a crease or a thin part whose centroid
+    /// ends up nearest to the surface's other side. Costs one nearest-triangle search
+    /// per moved face, against an index built once over the cleaned input. A refused
+    /// pair is not dropped but queued again at 32 times its cost (at least the cost of
+    /// moving it 1e-6 of the normalised diagonal), and contracted without the check when
+    /// it comes up again, unless it was re-costed meanwhile: at extreme ratios refusing
+    /// for good would force far costlier contractions elsewhere. Counted in
     /// [`SimplifyReport::rejected_orientation`](super::SimplifyReport::rejected_orientation).
     /// Default: `true`.
     pub orientation_check: bool,
