@@ -129,13 +129,30 @@ fn parse_non_negative(s: &str) -> Result<f64, String> {
     }
 }
 
-/// Parses `--weighting`: `area`, `unweighted` or `mixed:S` with S a finite number ≥ 0.
+/// The largest S of `--weighting mixed:S`. A face's weight is area + S·(mean area), so
+/// above this the area changes a weight by at most (faces / S), under 1e-6 for a
+/// million faces: `unweighted` is then the same ordering, without the risk of weights
+/// that overflow once summed.
+const MAX_WEIGHTING_MIX: f64 = 1e12;
+
+/// Parses `--weighting`: `area`, `unweighted` or `mixed:S` with S a finite number in
+/// [0, 1e12].
 pub fn parse_weighting(s: &str) -> Result<Weighting, String> {
     match s.trim() {
         "area" => Ok(Weighting::Area),
         "unweighted" => Ok(Weighting::Unweighted),
         other => match other.strip_prefix("mixed:") {
-            Some(mix) => Ok(Weighting::Mixed(parse_non_negative(mix.trim())?)),
+            Some(mix) => {
+                let mix = parse_non_negative(mix.trim())?;
+                if mix > MAX_WEIGHTING_MIX {
+                    // Face weights of s × the mean area would overflow f64 once summed.
+                    return Err(format!(
+                        "mixed:{mix} is too large: S must be at most {MAX_WEIGHTING_MIX:e} \
+                         (use `unweighted` for unit weights)"
+                    ));
+                }
+                Ok(Weighting::Mixed(mix))
+            }
             None => Err(format!(
                 "`{s}` is not a weighting: use area, unweighted or mixed:S (e.g. mixed:1)"
             )),
@@ -250,6 +267,10 @@ mod tests {
         assert_eq!(parse_weighting(" mixed: 2 "), Ok(Weighting::Mixed(2.0)));
         assert!(parse_weighting("mixed:-1").is_err());
         assert!(parse_weighting("mixed:inf").is_err());
+        assert!(parse_weighting("mixed:1e300")
+            .unwrap_err()
+            .contains("too large"));
+        assert_eq!(parse_weighting("mixed:1e12"), Ok(Weighting::Mixed(1e12)));
         assert!(parse_weighting("mixed").unwrap_err().contains("mixed:S"));
         assert!(parse_weighting("Area").is_err());
     }
