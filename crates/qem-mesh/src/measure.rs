@@ -477,6 +477,27 @@ impl TriangleBvh {
         }
     }
 
+    /// Pushes the two children of inner node `node` so that the one nearer to `p` is
+    /// popped first: the best distance of a nearest-triangle search then shrinks early
+    /// and prunes more.
+    fn push_children_nearer_last(
+        &self,
+        node: &Node,
+        p: P3,
+        stack: &mut smallvec::SmallVec<[u32; 64]>,
+    ) {
+        let (l, r) = (node.first, node.first + 1);
+        let dl = self.nodes[l as usize].bounds.distance2(p);
+        let dr = self.nodes[r as usize].bounds.distance2(p);
+        if dl <= dr {
+            stack.push(r);
+            stack.push(l);
+        } else {
+            stack.push(l);
+            stack.push(r);
+        }
+    }
+
     /// The exact distance from `p` to the nearest triangle, or `None` when there are no
     /// triangles.
     pub fn distance(&self, p: [f64; 3]) -> Option<f64> {
@@ -484,7 +505,7 @@ impl TriangleBvh {
             return None;
         }
         let mut best = f64::INFINITY;
-        let mut stack: Vec<u32> = Vec::with_capacity(64);
+        let mut stack: smallvec::SmallVec<[u32; 64]> = smallvec::SmallVec::new();
         stack.push(0);
         while let Some(n) = stack.pop() {
             let node = &self.nodes[n as usize];
@@ -497,17 +518,7 @@ impl TriangleBvh {
                     best = best.min(triangle_distance2(p, *a, *b, *c));
                 }
             } else {
-                // Visit the nearer child first (pushed last) so `best` shrinks early.
-                let (l, r) = (node.first, node.first + 1);
-                let dl = self.nodes[l as usize].bounds.distance2(p);
-                let dr = self.nodes[r as usize].bounds.distance2(p);
-                if dl <= dr {
-                    stack.push(r);
-                    stack.push(l);
-                } else {
-                    stack.push(l);
-                    stack.push(r);
-                }
+                self.push_children_nearer_last(node, p, &mut stack);
             }
         }
         Some(best.sqrt())
@@ -585,16 +596,7 @@ impl TriangleBvh {
                     }
                 }
             } else {
-                let (l, r) = (node.first, node.first + 1);
-                let dl = self.nodes[l as usize].bounds.distance2(p);
-                let dr = self.nodes[r as usize].bounds.distance2(p);
-                if dl <= dr {
-                    stack.push(r);
-                    stack.push(l);
-                } else {
-                    stack.push(l);
-                    stack.push(r);
-                }
+                self.push_children_nearer_last(node, p, &mut stack);
             }
         }
         // Compared as distances, not squares: squaring the limit back can round it
