@@ -703,6 +703,12 @@ impl TriangleBvh {
         false
     }
 
+    /// Number of indexed triangles (those of the mesh with valid indices); indices for
+    /// [`corners`](Self::corners) run below it.
+    pub fn triangle_count(&self) -> usize {
+        self.corners.len()
+    }
+
     /// The corners of triangle `i` (an index from
     /// [`nearest_triangles`](Self::nearest_triangles)), in their input order.
     pub fn corners(&self, i: u32) -> [[f64; 3]; 3] {

@@ -73,7 +73,7 @@ impl InputSurface {
             cleaned.triangles.clone(),
         );
         let bvh = TriangleBvh::new(&normalized);
-        let normals = (0..normalized.triangles.len() as u32)
+        let normals = (0..bvh.triangle_count() as u32)
             .map(|i| {
                 let [a, b, c] = bvh.corners(i).map(DVec3::from_array);
                 (b - a).cross(c - a)
