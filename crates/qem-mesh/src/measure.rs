@@ -391,6 +391,12 @@ impl TriangleBvh {
     /// their points are still on the surface). The mesh must pass
     /// [`IndexedMesh::validate`]; an index out of range would otherwise be skipped.
     pub fn new(mesh: &IndexedMesh) -> TriangleBvh {
+        Self::with_slots(mesh).0
+    }
+
+    /// [`new`](Self::new), and where each triangle went: `slots[i]` is the index (for
+    /// [`corners`](Self::corners)) of the `i`-th triangle of `mesh` with valid indices.
+    pub fn with_slots(mesh: &IndexedMesh) -> (TriangleBvh, Vec<u32>) {
         let corners: Vec<[P3; 3]> = mesh
             .triangles
             .iter()
@@ -461,6 +467,10 @@ impl TriangleBvh {
             stack.push((left + 1, mid, end));
         }
         let corners = order.iter().map(|&t| corners[t as usize]).collect();
+        let mut slots = vec![0u32; order.len()];
+        for (slot, &t) in order.iter().enumerate() {
+            slots[t as usize] = slot as u32;
+        }
         let root = nodes[0].bounds;
         let scale = (0..3)
             .map(|k| root.lo[k].abs().max(root.hi[k].abs()))
@@ -470,11 +480,14 @@ impl TriangleBvh {
         } else {
             0.0
         };
-        TriangleBvh {
-            nodes,
-            corners,
-            slack2: slack * slack,
-        }
+        (
+            TriangleBvh {
+                nodes,
+                corners,
+                slack2: slack * slack,
+            },
+            slots,
+        )
     }
 
     /// Pushes the two children of inner node `node` so that the one nearer to `p` is

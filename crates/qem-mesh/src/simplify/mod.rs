@@ -32,7 +32,7 @@ pub use options::{
 pub use report::{Simplified, SimplifyError, SimplifyReport, StopReason, Timings};
 
 use crate::clean::{clean, CleanOptions, Cleaned};
-use crate::store::MeshStore;
+use crate::store::{FaceKey, MeshStore};
 use crate::IndexedMesh;
 use engine::Engine;
 use qem_core::{DVec3, Frame};
@@ -157,14 +157,24 @@ pub fn simplify_levels(
     let clock = Instant::now();
     // The orientation check's index is independent of the quadrics and queue: built on
     // the other core meanwhile (deterministic either way).
+    // The store makes one face per cleaned triangle, in order, when none is refused;
+    // the index seeds each face's search hint with its own triangle.
+    let faces_in_order: Vec<FaceKey> = if options.orientation_check
+        && engine.store.face_count() == cleaned.mesh.triangles.len()
+    {
+        engine.store.faces().collect()
+    } else {
+        Vec::new()
+    };
     let ((), input_surface) = rayon::join(
         || engine.initialise(&cleaned.mesh, &keys, &locked, options),
         || {
-            options
-                .orientation_check
-                .then(|| orientation::InputSurface::new(&cleaned.mesh, &frame))
+            options.orientation_check.then(|| {
+                orientation::InputSurface::new(&cleaned.mesh, &frame, &faces_in_order)
+            })
         },
     );
+    drop(faces_in_order);
     engine.input_surface = input_surface;
     timings.setup = clock.elapsed();
     observer.cleaned(&cleaned.mesh, &frame);

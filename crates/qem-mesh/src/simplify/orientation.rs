@@ -62,8 +62,10 @@ pub(super) struct InputSurface {
 }
 
 impl InputSurface {
-    /// Indexes the cleaned mesh's triangles in the loop's frame.
-    pub fn new(cleaned: &IndexedMesh, frame: &Frame) -> InputSurface {
+    /// Indexes the cleaned mesh's triangles in the loop's frame. `faces[i]` is the
+    /// store's face made from the cleaned mesh's triangle `i` (or empty when the two do
+    /// not correspond one to one): each face's first hint is its own input triangle.
+    pub fn new(cleaned: &IndexedMesh, frame: &Frame, faces: &[FaceKey]) -> InputSurface {
         let normalized = IndexedMesh::new(
             cleaned
                 .positions
@@ -72,7 +74,17 @@ impl InputSurface {
                 .collect(),
             cleaned.triangles.clone(),
         );
-        let bvh = TriangleBvh::new(&normalized);
+        let (bvh, slots) = TriangleBvh::with_slots(&normalized);
+        // Why seed the hints: without one, a face's first test is a full nearest
+        // search (on the dragon at ratio 0.1, about 9 in 10 of the full searches).
+        // Any triangle would do for correctness (a hint only bounds the nearest
+        // distance from above); the face's own input triangle is the nearest one.
+        let mut hints = SecondaryMap::with_capacity(faces.len());
+        if faces.len() == slots.len() {
+            for (&face, &slot) in faces.iter().zip(&slots) {
+                hints.insert(face, slot);
+            }
+        }
         let normals = (0..bvh.triangle_count() as u32)
             .map(|i| {
                 let [a, b, c] = bvh.corners(i).map(DVec3::from_array);
@@ -84,7 +96,7 @@ impl InputSurface {
             bvh,
             normals,
             near: Vec::new(),
-            hints: SecondaryMap::new(),
+            hints,
         }
     }
 
