@@ -350,6 +350,38 @@ impl Aabb {
     }
 }
 
+/// A stack of node indices for the tree walks. Why a plain array: `SmallVec`'s push
+/// and pop (its inline-or-spilled checks) were 12% of the contraction loop's
+/// instructions through the orientation check's quick test. Why 64 is enough: the tree
+/// splits at the median, so a node `d` levels down holds at most `n / 2^d + 1`
+/// triangles and the depth stays below 33 for any `n < 2^32`; a walk pops one node for
+/// every two it pushes, so it never holds more than depth + 1 entries.
+struct NodeStack {
+    items: [u32; 64],
+    len: usize,
+}
+
+impl NodeStack {
+    fn with_root() -> NodeStack {
+        NodeStack {
+            items: [0; 64],
+            len: 1,
+        }
+    }
+
+    #[inline]
+    fn push(&mut self, n: u32) {
+        self.items[self.len] = n;
+        self.len += 1;
+    }
+
+    #[inline]
+    fn pop(&mut self) -> Option<u32> {
+        self.len = self.len.checked_sub(1)?;
+        Some(self.items[self.len])
+    }
+}
+
 /// Triangles per leaf: small leaves keep the exact tests few, large enough to keep the
 /// tree shallow.
 const LEAF_SIZE: usize = 4;
@@ -497,7 +529,7 @@ impl TriangleBvh {
         &self,
         node: &Node,
         p: P3,
-        stack: &mut smallvec::SmallVec<[u32; 64]>,
+        stack: &mut NodeStack,
     ) {
         let (l, r) = (node.first, node.first + 1);
         let dl = self.nodes[l as usize].bounds.distance2(p);
@@ -518,8 +550,7 @@ impl TriangleBvh {
             return None;
         }
         let mut best = f64::INFINITY;
-        let mut stack: smallvec::SmallVec<[u32; 64]> = smallvec::SmallVec::new();
-        stack.push(0);
+        let mut stack = NodeStack::with_root();
         while let Some(n) = stack.pop() {
             let node = &self.nodes[n as usize];
             if node.bounds.distance2(p) > best * PRUNE_FACTOR + self.slack2 {
@@ -584,8 +615,7 @@ impl TriangleBvh {
                 b
             }
         };
-        let mut stack: smallvec::SmallVec<[u32; 64]> = smallvec::SmallVec::new();
-        stack.push(0);
+        let mut stack = NodeStack::with_root();
         while let Some(n) = stack.pop() {
             let node = &self.nodes[n as usize];
             if node.bounds.distance2(p) > prune(best2, &candidates) {
@@ -687,11 +717,11 @@ impl TriangleBvh {
             return !self.corners.is_empty();
         }
         let radius2 = radius * radius * PRUNE_FACTOR + self.slack2;
-        let mut stack: smallvec::SmallVec<[u32; 64]> = smallvec::SmallVec::new();
-        stack.push(0);
+        let unit = unit_direction(normal);
+        let mut stack = NodeStack::with_root();
         while let Some(n) = stack.pop() {
             let node = &self.nodes[n as usize];
-            if node.bounds.distance2(p) > radius2 || bounds.all_face(n, normal) {
+            if node.bounds.distance2(p) > radius2 || unit.is_some_and(|u| bounds.all_face(n, u)) {
                 continue;
             }
             if node.count > 0 {
@@ -742,31 +772,35 @@ pub struct NormalBounds {
 const FACING_MARGIN: f64 = 1e-9;
 
 impl NormalBounds {
-    /// Whether every unit normal under node `n` has a positive dot product with
-    /// `normal`, by the least value of `x·normal` over the node's box of normals (a
+    /// Whether every unit normal under node `n` has a positive dot product with the
+    /// unit vector `unit`, by the least value of `x·unit` over the node's box of normals (a
     /// lower bound, since the unit normals lie in the box). An empty box (only
     /// zero-area triangles) faces every way.
-    fn all_face(&self, n: u32, normal: [f64; 3]) -> bool {
+    #[inline]
+    fn all_face(&self, n: u32, unit: [f64; 3]) -> bool {
         let b = &self.boxes[n as usize];
         if b.lo[0] > b.hi[0] {
             return true;
         }
-        let length = length(normal);
-        if !length.is_finite() || length <= 0.0 {
-            return false;
-        }
         let least: f64 = (0..3)
             .map(|k| {
-                let u = normal[k] / length;
-                if u >= 0.0 {
-                    u * b.lo[k]
+                if unit[k] >= 0.0 {
+                    unit[k] * b.lo[k]
                 } else {
-                    u * b.hi[k]
+                    unit[k] * b.hi[k]
                 }
             })
             .sum();
         least > FACING_MARGIN
     }
+}
+
+/// `v` scaled to unit length, or `None` when its length is zero, NaN or infinite (such
+/// a direction is never known to agree with a box of normals, so no subtree is skipped
+/// for it).
+fn unit_direction(v: P3) -> Option<P3> {
+    let length = length(v);
+    (length > 0.0 && length.is_finite()).then(|| v.map(|x| x / length))
 }
 
 /// The exact distance from `p` to the nearest triangle of `mesh`, by testing every
