@@ -174,6 +174,7 @@ pub fn optimal_placement(q: &Quadric, a: DVec3, b: DVec3) -> Placement {
 
 /// The best point on the segment `a`–`b`, or the best of the ends and the midpoint
 /// when the quadric is flat along the segment or rounding makes them better.
+#[inline]
 pub fn segment_placement(q: &Quadric, a: DVec3, b: DVec3) -> Placement {
     let fallback = endpoint_placement(q, a, b);
     // Along p(s) = a + s d: Q = Q(a) + 2 s dᵀ(A a + b) + s² dᵀA d, minimal at
@@ -202,6 +203,7 @@ pub fn segment_placement(q: &Quadric, a: DVec3, b: DVec3) -> Placement {
 
 /// The best of the midpoint and the two ends (in that order of preference on ties,
 /// so flat regions contract to the middle).
+#[inline]
 pub fn endpoint_placement(q: &Quadric, a: DVec3, b: DVec3) -> Placement {
     // Halves first: (a + b) / 2 would overflow for coordinates near f64::MAX.
     let mid = a * 0.5 + b * 0.5;
