@@ -88,9 +88,12 @@ pub fn minimize(q: &Quadric) -> Option<DVec3> {
     let mut first_pivot = 0.0;
     for k in 0..3 {
         // Largest remaining entry as pivot: the first in row-major order on ties.
+        // The first step scans only the upper triangle: `A` is symmetric (one field per
+        // pair of entries), so an entry below the diagonal always has an identical twin
+        // earlier in row-major order and can never win.
         let (mut pr, mut pc, mut best) = (k, k, -1.0);
         for r in k..3 {
-            for c in k..3 {
+            for c in if k == 0 { r } else { k }..3 {
                 let v = m[r][c].abs();
                 if v > best {
                     (pr, pc, best) = (r, c, v);
