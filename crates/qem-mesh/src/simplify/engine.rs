@@ -562,7 +562,16 @@ impl Engine {
     /// set, which answers the same.
     fn unwaive(&mut self, a: VertexKey, b: VertexKey) -> bool {
         let listed = |v| self.state.get(v).is_some_and(|s| s.waived_pairs > 0);
-        if !listed(a) || !listed(b) || !self.orientation_waived.remove(&ordered_pair(a, b)) {
+        if !listed(a) || !listed(b) {
+            debug_assert!(
+                !(self.state.contains_key(a)
+                    && self.state.contains_key(b)
+                    && self.orientation_waived.contains(&ordered_pair(a, b))),
+                "a waived pair of live vertices that its counts do not show"
+            );
+            return false;
+        }
+        if !self.orientation_waived.remove(&ordered_pair(a, b)) {
             return false;
         }
         self.state[a].waived_pairs -= 1;
