@@ -274,9 +274,23 @@ impl Quadric {
         }
     }
 
+    /// `f` applied entry by entry. Field by field rather than through
+    /// [`entries`](Quadric::entries) arrays: sums and differences of quadrics run for every
+    /// queued pair, and the arrays cost a copy each way.
+    #[inline]
     fn zip(self, other: Quadric, f: impl Fn(f64, f64) -> f64) -> Quadric {
-        let (a, b) = (self.entries(), other.entries());
-        Quadric::from_entries(std::array::from_fn(|i| f(a[i], b[i])))
+        Quadric {
+            xx: f(self.xx, other.xx),
+            xy: f(self.xy, other.xy),
+            xz: f(self.xz, other.xz),
+            yy: f(self.yy, other.yy),
+            yz: f(self.yz, other.yz),
+            zz: f(self.zz, other.zz),
+            x: f(self.x, other.x),
+            y: f(self.y, other.y),
+            z: f(self.z, other.z),
+            c: f(self.c, other.c),
+        }
     }
 }
 

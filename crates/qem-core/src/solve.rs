@@ -70,8 +70,15 @@ pub struct Placement {
 ///     + Quadric::from_plane(DVec3::Z, -3.0);
 /// assert_eq!(minimize(&q), Some(DVec3::new(1.0, 2.0, 3.0)));
 /// ```
+// Plain indexing on purpose (see the comment inside): clippy would have iterators.
+#[allow(clippy::needless_range_loop)]
 pub fn minimize(q: &Quadric) -> Option<DVec3> {
     // Augmented system [A | −b], solved by Gaussian elimination with full pivoting.
+    //
+    // Written with plain indexing over constant ranges (which the compiler unrolls)
+    // rather than iterator adapters: this runs for every queued pair, and the adapters
+    // cost about three times the instructions. The arithmetic is the textbook one, in
+    // the same order, so the bits do not depend on the spelling.
     let mut m = [
         [q.xx, q.xy, q.xz, -q.x],
         [q.xy, q.yy, q.yz, -q.y],
@@ -80,12 +87,16 @@ pub fn minimize(q: &Quadric) -> Option<DVec3> {
     let mut col_of = [0usize, 1, 2]; // which unknown each column now holds
     let mut first_pivot = 0.0;
     for k in 0..3 {
-        // Largest remaining entry as pivot.
+        // Largest remaining entry as pivot: the first in row-major order on ties.
+        // The first step scans only the upper triangle: `A` is symmetric (one field per
+        // pair of entries), so an entry below the diagonal always has an identical twin
+        // earlier in row-major order and can never win.
         let (mut pr, mut pc, mut best) = (k, k, -1.0);
-        for (r, row) in m.iter().enumerate().skip(k) {
-            for (c, v) in row.iter().enumerate().take(3).skip(k) {
-                if v.abs() > best {
-                    (pr, pc, best) = (r, c, v.abs());
+        for r in k..3 {
+            for c in if k == 0 { r } else { k }..3 {
+                let v = m[r][c].abs();
+                if v > best {
+                    (pr, pc, best) = (r, c, v);
                 }
             }
         }
@@ -99,16 +110,17 @@ pub fn minimize(q: &Quadric) -> Option<DVec3> {
         }
         m.swap(k, pr);
         if pc != k {
-            for row in m.iter_mut() {
+            for row in &mut m {
                 row.swap(k, pc);
             }
             col_of.swap(k, pc);
         }
-        let pivot_row = m[k];
-        for row in m.iter_mut().skip(k + 1) {
-            let f = row[k] / pivot_row[k];
-            for (v, p) in row.iter_mut().zip(pivot_row).skip(k) {
-                *v -= f * p;
+        // Column k below the pivot is never read again (later pivots and the back
+        // substitution look only right of it), so it is not updated.
+        for r in k + 1..3 {
+            let f = m[r][k] / m[k][k];
+            for c in k + 1..4 {
+                m[r][c] -= f * m[k][c];
             }
         }
     }
@@ -165,6 +177,7 @@ pub fn optimal_placement(q: &Quadric, a: DVec3, b: DVec3) -> Placement {
 
 /// The best point on the segment `a`–`b`, or the best of the ends and the midpoint
 /// when the quadric is flat along the segment or rounding makes them better.
+#[inline]
 pub fn segment_placement(q: &Quadric, a: DVec3, b: DVec3) -> Placement {
     let fallback = endpoint_placement(q, a, b);
     // Along p(s) = a + s d: Q = Q(a) + 2 s dᵀ(A a + b) + s² dᵀA d, minimal at
@@ -193,6 +206,7 @@ pub fn segment_placement(q: &Quadric, a: DVec3, b: DVec3) -> Placement {
 
 /// The best of the midpoint and the two ends (in that order of preference on ties,
 /// so flat regions contract to the middle).
+#[inline]
 pub fn endpoint_placement(q: &Quadric, a: DVec3, b: DVec3) -> Placement {
     // Halves first: (a + b) / 2 would overflow for coordinates near f64::MAX.
     let mid = a * 0.5 + b * 0.5;

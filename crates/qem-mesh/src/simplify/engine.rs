@@ -66,6 +66,9 @@ pub(super) struct VertexState {
     pub locked: bool,
     /// Index in the cleaned mesh (for [`Contraction`] events).
     pub index: u32,
+    /// How many pairs of this vertex are in [`Engine`]'s set of waived pairs (see
+    /// [`Engine::unwaive`]); a pair can be there only when both its ends count it.
+    waived_pairs: u32,
 }
 
 /// One vertex's state and the version of the key it belongs to (0: no vertex), padded
@@ -257,7 +260,8 @@ pub(super) struct Engine {
     /// Pairs (smaller key first) that failed the orientation check and were queued
     /// again at [`ORIENTATION_PENALTY`], and not re-costed since: when one pops, the
     /// check is waived (its cost already carries the penalty). Only looked up, never
-    /// iterated, so its order cannot matter.
+    /// iterated, so its order cannot matter; [`VertexState`] counts each vertex's pairs
+    /// here so that most look-ups need no hashing.
     orientation_waived: HashSet<(VertexKey, VertexKey)>,
     /// Reused buffer of the edges of the vertex being removed.
     b_edges: Vec<EdgeKey>,
@@ -535,9 +539,44 @@ impl Engine {
         let (placed, _) = self.place(a, b, ab);
         self.queue.push(placed.cost, a, b, ab);
         // Re-costed: a penalty from an earlier orientation refusal no longer applies.
-        if !self.orientation_waived.is_empty() {
-            self.orientation_waived.remove(&ordered_pair(a, b));
+        self.unwaive(a, b);
+    }
+
+    /// Lists the pair `a`, `b` (both live) as waived: queued again at a penalty after an
+    /// orientation refusal.
+    fn waive(&mut self, a: VertexKey, b: VertexKey) {
+        if self.orientation_waived.insert(ordered_pair(a, b)) {
+            self.state[a].waived_pairs += 1;
+            self.state[b].waived_pairs += 1;
         }
+    }
+
+    /// Takes the pair `a`, `b` off the waived list; whether it was there (always false
+    /// when either end is gone, as no such pair is ever asked about again).
+    ///
+    /// Why the per-vertex counts: this runs for every queued pair, and once any pair has
+    /// been waived the set is never empty again, so without them every push hashed a
+    /// pair (about 3% of the loop's instructions); the counts, read next to the quadric
+    /// the placement just read, rule out almost every pair without hashing. Counts of a
+    /// removed vertex's pairs stay on its neighbours: they only make the test ask the
+    /// set, which answers the same.
+    fn unwaive(&mut self, a: VertexKey, b: VertexKey) -> bool {
+        let listed = |v| self.state.get(v).is_some_and(|s| s.waived_pairs > 0);
+        if !listed(a) || !listed(b) {
+            debug_assert!(
+                !(self.state.contains_key(a)
+                    && self.state.contains_key(b)
+                    && self.orientation_waived.contains(&ordered_pair(a, b))),
+                "a waived pair of live vertices that its counts do not show"
+            );
+            return false;
+        }
+        if !self.orientation_waived.remove(&ordered_pair(a, b)) {
+            return false;
+        }
+        self.state[a].waived_pairs -= 1;
+        self.state[b].waived_pairs -= 1;
+        true
     }
 
     // Out of line (it runs once per level, so this costs nothing) so that profilers
@@ -589,16 +628,14 @@ impl Engine {
             } else {
                 self.world_position(&placed, a)
             };
-            let pair = ordered_pair(candidate.a, candidate.b);
-            let waived =
-                !self.orientation_waived.is_empty() && self.orientation_waived.remove(&pair);
+            let waived = self.unwaive(a, b);
             if let Err(why) = self.check(a, b, ab, world, !waived) {
                 self.counters.reject(why);
                 if why == Rejection::Orientation {
                     // Not refused for good: queued again at a penalty, so it is taken
                     // only when every alternative costs more (see ORIENTATION_PENALTY).
                     // Same names in the same order: the tie-break stays the push's.
-                    self.orientation_waived.insert(pair);
+                    self.waive(a, b);
                     let floor = q.weight() * PENALTY_FLOOR_DISTANCE * PENALTY_FLOOR_DISTANCE;
                     self.queue.push(
                         placed.cost.max(floor) * ORIENTATION_PENALTY,
