@@ -437,16 +437,23 @@ impl TriangleBvh {
                 Some([p(t[0])?, p(t[1])?, p(t[2])?])
             })
             .collect();
-        let centroids: Vec<P3> = corners
-            .iter()
-            .map(|[a, b, c]| {
-                [
-                    (a[0] + b[0] + c[0]) / 3.0,
-                    (a[1] + b[1] + c[1]) / 3.0,
-                    (a[2] + b[2] + c[2]) / 3.0,
-                ]
-            })
-            .collect();
+        Self::from_corners(corners)
+    }
+
+    /// The index over these triangles (given by their corners), and where each went:
+    /// `slots[i]` is the index (for [`corners`](Self::corners)) of `corners[i]`. Takes
+    /// the corners by value and reorders them in place, so the build needs no second
+    /// copy (a large mesh's corners are 72 bytes per triangle).
+    pub fn from_corners(mut corners: Vec<[P3; 3]>) -> (TriangleBvh, Vec<u32>) {
+        // Computed where needed rather than stored: the same expression gives the same
+        // bits every time, and a stored copy would cost 24 bytes per triangle.
+        let centroid = |c: &[P3; 3]| -> P3 {
+            [
+                (c[0][0] + c[1][0] + c[2][0]) / 3.0,
+                (c[0][1] + c[1][1] + c[2][1]) / 3.0,
+                (c[0][2] + c[1][2] + c[2][2]) / 3.0,
+            ]
+        };
         let mut order: Vec<u32> = (0..corners.len() as u32).collect();
         let mut nodes = Vec::with_capacity(2 * corners.len() / LEAF_SIZE + 1);
         nodes.push(Node {
@@ -463,7 +470,7 @@ impl TriangleBvh {
                 for corner in corners[t as usize] {
                     bounds.grow(corner);
                 }
-                centroid_box.grow(centroids[t as usize]);
+                centroid_box.grow(centroid(&corners[t as usize]));
             }
             nodes[node].bounds = bounds;
             if end - start <= LEAF_SIZE {
@@ -481,8 +488,8 @@ impl TriangleBvh {
             };
             let mid = start + (end - start) / 2;
             order[start..end].select_nth_unstable_by(mid - start, |&x, &y| {
-                centroids[x as usize][axis]
-                    .total_cmp(&centroids[y as usize][axis])
+                centroid(&corners[x as usize])[axis]
+                    .total_cmp(&centroid(&corners[y as usize])[axis])
                     .then(x.cmp(&y))
             });
             let left = nodes.len();
@@ -498,11 +505,22 @@ impl TriangleBvh {
             stack.push((left, start, mid));
             stack.push((left + 1, mid, end));
         }
-        let corners = order.iter().map(|&t| corners[t as usize]).collect();
         let mut slots = vec![0u32; order.len()];
         for (slot, &t) in order.iter().enumerate() {
             slots[t as usize] = slot as u32;
         }
+        drop(order);
+        // Leaf order in place: each triangle swapped straight to its slot, cycle by
+        // cycle (`destination` follows the triangles as they move).
+        let mut destination = slots.clone();
+        for i in 0..corners.len() {
+            while destination[i] as usize != i {
+                let d = destination[i] as usize;
+                corners.swap(i, d);
+                destination.swap(i, d);
+            }
+        }
+        drop(destination);
         let root = nodes[0].bounds;
         let scale = (0..3)
             .map(|k| root.lo[k].abs().max(root.hi[k].abs()))

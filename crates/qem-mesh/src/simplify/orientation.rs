@@ -51,8 +51,6 @@ pub(super) struct InputSurface {
     bvh: TriangleBvh,
     /// Per-node bounds of the unit normals, for the quick test.
     normal_bounds: NormalBounds,
-    /// Unnormalised normals of the indexed triangles, in the index's order.
-    normals: Vec<DVec3>,
     /// Reused query result.
     near: Vec<u32>,
     /// The input triangle nearest to each face at its last full test. Its distance to
@@ -66,15 +64,20 @@ impl InputSurface {
     /// store's face made from the cleaned mesh's triangle `i` (or empty when the two do
     /// not correspond one to one): each face's first hint is its own input triangle.
     pub fn new(cleaned: &IndexedMesh, frame: &Frame, faces: &[FaceKey]) -> InputSurface {
-        let normalized = IndexedMesh::new(
+        // The corners in the loop's frame, gathered straight into the index (a
+        // normalised copy of the mesh first would cost its size again at the peak).
+        let to_loop = |i: u32| {
             cleaned
                 .positions
-                .iter()
+                .get(i as usize)
                 .map(|p| frame.to_normalized(DVec3::from_array(*p)).to_array())
-                .collect(),
-            cleaned.triangles.clone(),
-        );
-        let (bvh, slots) = TriangleBvh::with_slots(&normalized);
+        };
+        let corners: Vec<[[f64; 3]; 3]> = cleaned
+            .triangles
+            .iter()
+            .filter_map(|t| Some([to_loop(t[0])?, to_loop(t[1])?, to_loop(t[2])?]))
+            .collect();
+        let (bvh, slots) = TriangleBvh::from_corners(corners);
         // Why seed the hints: without one, a face's first test is a full nearest
         // search (on the dragon at ratio 0.1, about 9 in 10 of the full searches).
         // Any triangle would do for correctness (a hint only bounds the nearest
@@ -85,16 +88,9 @@ impl InputSurface {
                 hints.insert(face, slot);
             }
         }
-        let normals = (0..bvh.triangle_count() as u32)
-            .map(|i| {
-                let [a, b, c] = bvh.corners(i).map(DVec3::from_array);
-                (b - a).cross(c - a)
-            })
-            .collect();
         InputSurface {
             normal_bounds: bvh.normal_bounds(),
             bvh,
-            normals,
             near: Vec::new(),
             hints,
         }
@@ -145,8 +141,11 @@ impl InputSurface {
             *neighbour_hint = Some(t);
         }
         // A zero-area input triangle (cleaning drops exact ones) has no say.
+        // (Normals computed here rather than kept: 24 bytes per input triangle saved,
+        // and this full test is rare once every face has a hint.)
         self.near.iter().all(|&i| {
-            let n = self.normals[i as usize];
+            let [a, b, c] = self.bvh.corners(i).map(DVec3::from_array);
+            let n = (b - a).cross(c - a);
             n.dot(normal) > 0.0 || n == DVec3::ZERO
         })
     }
