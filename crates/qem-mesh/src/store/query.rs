@@ -192,11 +192,10 @@ impl MeshStore {
             for &f in self.fan(e) {
                 // A face at v appears in the fans of two star edges; taking it only at the
                 // edge from v to its successor in the face lists it exactly once.
+                // (A face's vertices are distinct, so at most one slot holds v.)
                 let face = &self.faces[f];
-                if let Some(slot) = face.vertices.iter().position(|&x| x == packed_v) {
-                    if face.edges[slot] == packed_e {
-                        out.push(f);
-                    }
+                if (0..3).any(|s| face.vertices[s] == packed_v && face.edges[s] == packed_e) {
+                    out.push(f);
                 }
             }
         }
