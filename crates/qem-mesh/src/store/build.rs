@@ -10,11 +10,13 @@
 //! independent, so the store is the same for any number of threads. The slot maps
 //! themselves are filled in one thread, in a fixed order.
 
+use std::marker::PhantomData;
+
 use rayon::prelude::*;
 use slotmap::SlotMap;
 use smallvec::SmallVec;
 
-use super::{ordered, Edge, EdgeKey, Face, MeshStore, Vertex, VertexKey};
+use super::{ordered_packed, Edge, EdgeKey, Face, FanPool, MeshStore, Packed, Vertex, VertexKey};
 use crate::clean::group_equal_sets;
 use crate::input::{IndexedMesh, InputError};
 
@@ -133,24 +135,27 @@ impl MeshStore {
             .map(|&t| {
                 let [i, j, k] = mesh.triangles[t as usize];
                 faces.insert(Face {
-                    vertices: [keys[i as usize], keys[j as usize], keys[k as usize]],
-                    edges: Default::default(),
+                    vertices: [i, j, k].map(|i| Packed::new(keys[i as usize])),
+                    // Set below, once the edges exist (index 0 is slotmap's sentinel slot,
+                    // never a key).
+                    edges: [Packed(0, PhantomData); 3],
                 })
             })
             .collect();
         let mut edges = SlotMap::with_capacity_and_key(runs.len());
+        let mut fans = FanPool::default();
         let edge_keys: Vec<EdgeKey> = runs
             .iter()
             .map(|run| {
                 let (lo, hi) = (keys[run[0].0 as usize], keys[run[0].1 as usize]);
                 edges.insert(Edge {
-                    vertices: ordered(lo, hi),
-                    fan: run.iter().map(|r| face_keys[r.2 as usize]).collect(),
+                    vertices: ordered_packed(lo, hi),
+                    fan: fans.make(run.iter().map(|r| face_keys[r.2 as usize])),
                 })
             })
             .collect();
         for (f, e) in face_keys.iter().zip(&face_edges) {
-            faces[*f].edges = e.map(|e| edge_keys[e as usize]);
+            faces[*f].edges = e.map(|e| Packed::new(edge_keys[e as usize]));
         }
         for (i, key) in keys.iter().enumerate() {
             let star = &stars[star_start[i] as usize..star_start[i + 1] as usize];
@@ -164,6 +169,7 @@ impl MeshStore {
             vertices,
             edges,
             faces,
+            fans,
             build_stats: stats,
             scratch: Default::default(),
         };

@@ -41,7 +41,7 @@ impl MeshStore {
         // order in which faces happen to reach them.
         let mut index: SecondaryMap<VertexKey, u32> = SecondaryMap::new();
         for face in self.faces.values() {
-            for &v in &face.vertices {
+            for v in face.vertex_keys() {
                 index.insert(v, 0);
             }
         }
@@ -59,7 +59,10 @@ impl MeshStore {
         let triangles = self
             .faces
             .values()
-            .map(|face| face.vertices.map(|v| index.get(v).copied().unwrap_or(0)))
+            .map(|face| {
+                face.vertex_keys()
+                    .map(|v| index.get(v).copied().unwrap_or(0))
+            })
             .collect();
         (IndexedMesh::new(positions, triangles), keys)
     }

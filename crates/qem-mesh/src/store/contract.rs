@@ -13,7 +13,7 @@
 //!    neighbour, fans joined. No face can be in both fans (it would contain `a` and `b`
 //!    and was removed in step 1), so joining is a plain append.
 
-use super::{ordered, remove_item, EdgeKey, FaceKey, MeshStore, VertexKey};
+use super::{ordered_packed, remove_item, EdgeKey, FaceKey, MeshStore, Packed, VertexKey};
 
 /// What one [`MeshStore::contract`] did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -246,11 +246,12 @@ impl MeshStore {
         // store while walking them; put back at the end to keep their capacity.
         let mut faces = std::mem::take(&mut self.scratch.faces);
         let mut edges = std::mem::take(&mut self.scratch.edges);
+        let mut moved = std::mem::take(&mut self.scratch.moved);
 
         // Step 1: the faces on edge a-b collapse, then the edge itself.
         if let Some(ab) = ab {
             faces.clear();
-            faces.extend_from_slice(&self.edges[ab].fan);
+            faces.extend_from_slice(self.fan(ab));
             for &f in &faces {
                 self.remove_face(f);
             }
@@ -280,15 +281,14 @@ impl MeshStore {
         self.faces_of_vertex(b, &mut faces);
         for &f in &faces {
             let face = self.faces[f];
-            let Some(slot) = face.vertices.iter().position(|&v| v == b) else {
+            let Some(slot) = face.slot_of(b) else {
                 continue;
             };
-            let x = face.vertices[(slot + 1) % 3];
+            let x = face.vertices[(slot + 1) % 3].key();
             let y = face.vertices[(slot + 2) % 3];
             // The face a x y, if any (as `find_face`, with a's edge to x from `links`).
             let kept = edge_to(x).and_then(|ax| {
-                self.edges[ax]
-                    .fan
+                self.fan(ax)
                     .iter()
                     .copied()
                     .find(|&g| self.faces[g].vertices.contains(&y))
@@ -300,7 +300,7 @@ impl MeshStore {
                     log.faces_merged.push((f, kept));
                 }
             } else {
-                self.faces[f].vertices[slot] = a;
+                self.faces[f].vertices[slot] = Packed::new(a);
             }
         }
 
@@ -313,15 +313,17 @@ impl MeshStore {
             };
             match edge_to(x) {
                 Some(keep) => {
-                    let moved = std::mem::take(&mut self.edges[e].fan);
+                    moved.clear();
+                    self.fans.take(&mut self.edges[e].fan, &mut moved);
+                    let (packed_e, packed_keep) = (Packed::new(e), Packed::new(keep));
                     for &f in &moved {
                         for slot in &mut self.faces[f].edges {
-                            if *slot == e {
-                                *slot = keep;
+                            if *slot == packed_e {
+                                *slot = packed_keep;
                             }
                         }
-                        debug_assert!(!self.edges[keep].fan.contains(&f));
-                        self.edges[keep].fan.push(f);
+                        debug_assert!(!self.fan(keep).contains(&f));
+                        self.fans.push(&mut self.edges[keep].fan, f);
                     }
                     remove_item(&mut self.vertices[x].star, &e);
                     self.edges.remove(e);
@@ -331,7 +333,7 @@ impl MeshStore {
                     }
                 }
                 None => {
-                    self.edges[e].vertices = ordered(a, x);
+                    self.edges[e].vertices = ordered_packed(a, x);
                     self.vertices[a].star.push(e);
                 }
             }
@@ -342,6 +344,7 @@ impl MeshStore {
         self.scratch.faces = faces;
         self.scratch.edges = edges;
         self.scratch.links = links;
+        self.scratch.moved = moved;
         outcome
     }
 
@@ -352,19 +355,18 @@ impl MeshStore {
     /// If `a` or `x` is not in the store.
     pub fn find_face(&self, a: VertexKey, x: VertexKey, y: VertexKey) -> Option<FaceKey> {
         let e = self.find_edge(a, x)?;
-        self.edges[e]
-            .fan
+        self.fan(e)
             .iter()
             .copied()
-            .find(|&f| self.faces[f].vertices.contains(&y))
+            .find(|&f| self.faces[f].has_vertex(y))
     }
 
     /// Removes face `f` from the fans of its edges and from the store.
     fn remove_face(&mut self, f: FaceKey) {
         if let Some(face) = self.faces.remove(f) {
-            for e in face.edges {
+            for e in face.edge_keys() {
                 if let Some(edge) = self.edges.get_mut(e) {
-                    remove_item(&mut edge.fan, &f);
+                    self.fans.remove(&mut edge.fan, f);
                 }
             }
         }
@@ -373,8 +375,9 @@ impl MeshStore {
     /// Removes edge `e` from the stars of its endpoints and from the store. Its fan must
     /// already be empty or about to be discarded by the caller.
     fn remove_edge(&mut self, e: EdgeKey) {
-        if let Some(edge) = self.edges.remove(e) {
-            for v in edge.vertices {
+        if let Some(mut edge) = self.edges.remove(e) {
+            self.fans.clear(&mut edge.fan);
+            for v in edge.vertex_keys() {
                 if let Some(vertex) = self.vertices.get_mut(v) {
                     remove_item(&mut vertex.star, &e);
                 }

@@ -6,7 +6,7 @@
 
 use slotmap::SecondaryMap;
 
-use super::{EdgeKey, FaceKey, MeshStore, VertexKey};
+use super::{EdgeKey, FaceKey, MeshStore, Packed, VertexKey};
 
 /// How many faces an edge has, which decides its role in the surface.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -123,7 +123,7 @@ impl MeshStore {
     /// # Panics
     /// If `e` is not in the store.
     pub fn edge_vertices(&self, e: EdgeKey) -> [VertexKey; 2] {
-        self.edges[e].vertices
+        self.edges[e].vertex_keys()
     }
 
     /// The endpoint of `e` that is not `v`, or `None` if `v` is not an endpoint of `e`.
@@ -131,7 +131,7 @@ impl MeshStore {
     /// # Panics
     /// If `e` is not in the store.
     pub fn other_vertex(&self, e: EdgeKey, v: VertexKey) -> Option<VertexKey> {
-        match self.edges[e].vertices {
+        match self.edges[e].vertex_keys() {
             [a, b] if a == v => Some(b),
             [a, b] if b == v => Some(a),
             _ => None,
@@ -142,8 +142,9 @@ impl MeshStore {
     ///
     /// # Panics
     /// If `e` is not in the store.
+    #[inline]
     pub fn fan(&self, e: EdgeKey) -> &[FaceKey] {
-        &self.edges[e].fan
+        self.fans.get(&self.edges[e].fan)
     }
 
     /// The three vertices of `f`, in its orientation.
@@ -151,7 +152,7 @@ impl MeshStore {
     /// # Panics
     /// If `f` is not in the store.
     pub fn face_vertices(&self, f: FaceKey) -> [VertexKey; 3] {
-        self.faces[f].vertices
+        self.faces[f].vertex_keys()
     }
 
     /// The three edges of `f`: element `i` joins `face_vertices(f)[i]` and
@@ -160,7 +161,7 @@ impl MeshStore {
     /// # Panics
     /// If `f` is not in the store.
     pub fn face_edges(&self, f: FaceKey) -> [EdgeKey; 3] {
-        self.faces[f].edges
+        self.faces[f].edge_keys()
     }
 
     /// The vertex of `f` that is not an endpoint of `e`, or `None` if `e` is not an edge
@@ -170,8 +171,8 @@ impl MeshStore {
     /// If `f` or `e` is not in the store.
     pub fn opposite_vertex(&self, f: FaceKey, e: EdgeKey) -> Option<VertexKey> {
         let face = &self.faces[f];
-        let slot = face.edges.iter().position(|&x| x == e)?;
-        Some(face.vertices[(slot + 2) % 3])
+        let slot = face.edges.iter().position(|x| x.key() == e)?;
+        Some(face.vertices[(slot + 2) % 3].key())
     }
 
     /// Writes every face containing `v` into `out` (cleared first), each once.
@@ -184,15 +185,17 @@ impl MeshStore {
     /// If `v` is not in the store.
     pub fn faces_of_vertex(&self, v: VertexKey, out: &mut Vec<FaceKey>) {
         out.clear();
+        // Both keys are live (indexing checked them), so comparing indices is exact.
+        let packed_v = Packed::new(v);
         for &e in &self.vertices[v].star {
-            for &f in &self.edges[e].fan {
+            let packed_e = Packed::new(e);
+            for &f in self.fan(e) {
                 // A face at v appears in the fans of two star edges; taking it only at the
                 // edge from v to its successor in the face lists it exactly once.
+                // (A face's vertices are distinct, so at most one slot holds v.)
                 let face = &self.faces[f];
-                if let Some(slot) = face.vertices.iter().position(|&x| x == v) {
-                    if face.edges[slot] == e {
-                        out.push(f);
-                    }
+                if (0..3).any(|s| face.vertices[s] == packed_v && face.edges[s] == packed_e) {
+                    out.push(f);
                 }
             }
         }
@@ -212,10 +215,9 @@ impl MeshStore {
     pub fn find_edge(&self, a: VertexKey, b: VertexKey) -> Option<EdgeKey> {
         let sa = &self.vertices[a].star;
         if sa.len() <= SHORT_STAR {
-            return sa
-                .iter()
-                .copied()
-                .find(|&e| self.other_vertex(e, a) == Some(b));
+            // A key with a later version than any record holds is an endpoint of no edge.
+            let (pa, pb) = (Packed::new(a), Packed::try_new(b)?);
+            return sa.iter().copied().find(|&e| self.edges[e].joins(pa, pb));
         }
         let sb = &self.vertices[b].star;
         let (star, from) = if sa.len() <= sb.len() {
@@ -253,11 +255,14 @@ impl MeshStore {
             if let Some(x) = self.other_vertex(e, v) {
                 vertices.push(x);
             }
-            for &f in &self.edges[e].fan {
+            for &f in self.fan(e) {
                 let face = &self.faces[f];
-                if let Some(slot) = face.vertices.iter().position(|&x| x == v) {
-                    if face.edges[slot] == e {
-                        edges.push([face.vertices[(slot + 1) % 3], face.vertices[(slot + 2) % 3]]);
+                if let Some(slot) = face.slot_of(v) {
+                    if face.edges[slot] == Packed::new(e) {
+                        edges.push([
+                            face.vertices[(slot + 1) % 3].key(),
+                            face.vertices[(slot + 2) % 3].key(),
+                        ]);
                     }
                 }
             }
@@ -272,7 +277,7 @@ impl MeshStore {
     /// If `e` is not in the store.
     pub fn edge_link(&self, e: EdgeKey, out: &mut Vec<VertexKey>) {
         out.clear();
-        for &f in &self.edges[e].fan {
+        for &f in self.fan(e) {
             if let Some(x) = self.opposite_vertex(f, e) {
                 out.push(x);
             }
@@ -295,12 +300,7 @@ impl MeshStore {
     pub fn link_condition(&self, a: VertexKey, b: VertexKey) -> bool {
         let ab = self.find_edge(a, b);
         let opposite_ab = |x: VertexKey| {
-            ab.is_some_and(|e| {
-                self.edges[e]
-                    .fan
-                    .iter()
-                    .any(|&f| self.faces[f].vertices.contains(&x))
-            })
+            ab.is_some_and(|e| self.fan(e).iter().any(|&f| self.faces[f].has_vertex(x)))
         };
         // Vertices: a common neighbour not opposite a-b would be pinched. The converse
         // holds by construction (a face a b x has edges a-x and b-x).
@@ -314,16 +314,19 @@ impl MeshStore {
         }
         // Edges: Lk ab has none, so no link edge x y may be shared by a and b.
         for &e in &self.vertices[a].star {
-            for &f in &self.edges[e].fan {
+            for &f in self.fan(e) {
                 let face = &self.faces[f];
-                let Some(slot) = face.vertices.iter().position(|&v| v == a) else {
+                let Some(slot) = face.slot_of(a) else {
                     continue;
                 };
                 // Each face once: at the edge leaving a in face order.
-                if face.edges[slot] != e || face.vertices.contains(&b) {
+                if face.edges[slot] != Packed::new(e) || face.has_vertex(b) {
                     continue;
                 }
-                let (x, y) = (face.vertices[(slot + 1) % 3], face.vertices[(slot + 2) % 3]);
+                let (x, y) = (
+                    face.vertices[(slot + 1) % 3].key(),
+                    face.vertices[(slot + 2) % 3].key(),
+                );
                 if self.find_face(b, x, y).is_some() {
                     return false;
                 }
@@ -337,7 +340,7 @@ impl MeshStore {
     /// # Panics
     /// If `e` is not in the store.
     pub fn classify_edge(&self, e: EdgeKey) -> EdgeClass {
-        match self.edges[e].fan.len() {
+        match self.fan(e).len() {
             0 => EdgeClass::Wire,
             1 => EdgeClass::Boundary,
             2 => EdgeClass::Manifold,
@@ -359,7 +362,7 @@ impl MeshStore {
         let mut border = None;
         let mut border_count = 0usize;
         for &e in star {
-            match self.edges[e].fan.len() {
+            match self.fan(e).len() {
                 1 => {
                     border_count += 1;
                     border = Some(e);
@@ -367,7 +370,7 @@ impl MeshStore {
                 2 => {}
                 _ => return VertexClass::NonManifold,
             }
-            face_count += self.edges[e].fan.len();
+            face_count += self.fan(e).len();
         }
         face_count /= 2;
         // Walk one fan from its start: a border edge if there is one, else any edge.
@@ -380,13 +383,13 @@ impl MeshStore {
         // `start`); it is the only fan exactly when it visits every face at v.
         let mut visited = 0usize;
         let mut edge = start;
-        let mut face = self.edges[start].fan[0];
+        let mut face = self.fan(start)[0];
         loop {
             visited += 1;
             let Some(next_edge) = self.other_edge_at(face, edge, v) else {
                 return VertexClass::NonManifold;
             };
-            let fan = &self.edges[next_edge].fan;
+            let fan = self.fan(next_edge);
             if next_edge == start || fan.len() < 2 {
                 break;
             }
@@ -407,9 +410,9 @@ impl MeshStore {
     /// The edge of face `f` that contains `v` and is not `e`.
     fn other_edge_at(&self, f: FaceKey, e: EdgeKey, v: VertexKey) -> Option<EdgeKey> {
         let face = &self.faces[f];
-        let slot = face.vertices.iter().position(|&x| x == v)?;
+        let slot = face.slot_of(v)?;
         // The two edges at vertices[slot] are edges[slot] and edges[slot + 2].
-        let (first, second) = (face.edges[slot], face.edges[(slot + 2) % 3]);
+        let (first, second) = (face.edges[slot].key(), face.edges[(slot + 2) % 3].key());
         if first == e {
             Some(second)
         } else if second == e {

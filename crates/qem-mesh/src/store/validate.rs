@@ -196,7 +196,7 @@ impl MeshStore {
                 let Some(e) = self.edges.get(edge) else {
                     return Err(StoreError::StarEdgeMissing { vertex, edge });
                 };
-                if !e.vertices.contains(&vertex) {
+                if !e.vertex_keys().contains(&vertex) {
                     return Err(StoreError::StarEdgeNotIncident { vertex, edge });
                 }
             }
@@ -207,7 +207,7 @@ impl MeshStore {
     fn validate_edges(&self) -> Result<(), StoreError> {
         let mut pairs = Vec::with_capacity(self.edges.len());
         for (edge, e) in &self.edges {
-            for vertex in e.vertices {
+            for vertex in e.vertex_keys() {
                 let Some(v) = self.vertices.get(vertex) else {
                     return Err(StoreError::EdgeVertexMissing { edge, vertex });
                 };
@@ -223,16 +223,16 @@ impl MeshStore {
             if e.vertices[0] >= e.vertices[1] {
                 return Err(StoreError::EdgeNotCanonical { edge });
             }
-            for &face in &e.fan {
+            for &face in self.fans.get(&e.fan) {
                 let Some(f) = self.faces.get(face) else {
                     return Err(StoreError::FanFaceMissing { edge, face });
                 };
-                if !f.edges.contains(&edge) {
+                if !f.edge_keys().contains(&edge) {
                     return Err(StoreError::FanFaceNotIncident { edge, face });
                 }
                 // A repeated fan entry is reported from the face side (count != 1).
             }
-            pairs.push((e.vertices, edge));
+            pairs.push((e.vertex_keys(), edge));
         }
         pairs.sort_unstable();
         for w in pairs.windows(2) {
@@ -249,7 +249,8 @@ impl MeshStore {
     fn validate_faces(&self) -> Result<(), StoreError> {
         let mut sets = Vec::with_capacity(self.faces.len());
         for (face, f) in &self.faces {
-            for vertex in f.vertices {
+            let vertices = f.vertex_keys();
+            for vertex in vertices {
                 if !self.vertices.contains_key(vertex) {
                     return Err(StoreError::FaceVertexMissing { face, vertex });
                 }
@@ -258,20 +259,20 @@ impl MeshStore {
             if p == q || q == r || r == p {
                 return Err(StoreError::DegenerateFace { face });
             }
-            for (slot, &edge) in f.edges.iter().enumerate() {
+            for (slot, edge) in f.edge_keys().into_iter().enumerate() {
                 let Some(e) = self.edges.get(edge) else {
                     return Err(StoreError::FaceEdgeMissing { face, edge });
                 };
-                let want = super::ordered(f.vertices[slot], f.vertices[(slot + 1) % 3]);
-                if e.vertices != want {
+                let want = super::ordered(vertices[slot], vertices[(slot + 1) % 3]);
+                if e.vertex_keys() != want {
                     return Err(StoreError::FaceEdgeMismatch { face, slot });
                 }
-                let count = e.fan.iter().filter(|&&x| x == face).count();
+                let count = self.fan(edge).iter().filter(|&&x| x == face).count();
                 if count != 1 {
                     return Err(StoreError::FaceNotInFanOnce { face, edge, count });
                 }
             }
-            let mut set = f.vertices;
+            let mut set = vertices;
             set.sort_unstable();
             sets.push((set, face));
         }
@@ -367,8 +368,8 @@ mod tests {
     fn broken_fans() {
         let (mut s, k) = square();
         let e = shared(&s, &k);
-        let f = s.edges[e].fan[0];
-        s.edges[e].fan.push(f);
+        let f = s.fan(e)[0];
+        s.fans.push(&mut s.edges[e].fan, f);
         assert_eq!(
             s.validate(),
             Err(StoreError::FaceNotInFanOnce {
@@ -377,7 +378,7 @@ mod tests {
                 count: 2
             })
         );
-        s.edges[e].fan.clear();
+        s.fans.clear(&mut s.edges[e].fan);
         assert!(matches!(
             s.validate(),
             Err(StoreError::FaceNotInFanOnce { count: 0, .. })
@@ -385,7 +386,7 @@ mod tests {
 
         // Keys are deterministic, so `e` names the same edge in a fresh store.
         let (mut s, _) = square();
-        let f = s.edges[e].fan[0];
+        let f = s.fan(e)[0];
         s.faces.remove(f);
         assert!(matches!(
             s.validate(),
@@ -394,8 +395,8 @@ mod tests {
 
         let (mut s, k) = square();
         let boundary = s.find_edge(k[0], k[1]).expect("0-1");
-        let other = s.edges[e].fan[1];
-        s.edges[boundary].fan.push(other);
+        let other = s.fan(e)[1];
+        s.fans.push(&mut s.edges[boundary].fan, other);
         assert_eq!(
             s.validate(),
             Err(StoreError::FanFaceNotIncident {
@@ -409,7 +410,7 @@ mod tests {
     fn broken_faces() {
         let (mut s, k) = square();
         let f = s.faces().next().expect("a face");
-        s.faces[f].vertices[2] = k[0];
+        s.faces[f].vertices[2] = super::super::Packed::new(k[0]);
         assert_eq!(s.validate(), Err(StoreError::DegenerateFace { face: f }));
 
         let (mut s, _) = square();
@@ -424,8 +425,8 @@ mod tests {
         copy.vertices.reverse();
         copy.edges = [copy.edges[1], copy.edges[0], copy.edges[2]];
         let g = s.faces.insert(copy);
-        for e in copy.edges {
-            s.edges[e].fan.push(g);
+        for e in copy.edge_keys() {
+            s.fans.push(&mut s.edges[e].fan, g);
         }
         assert_eq!(
             s.validate(),
