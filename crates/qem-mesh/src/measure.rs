@@ -546,12 +546,7 @@ impl TriangleBvh {
     /// Pushes the two children of inner node `node` so that the one nearer to `p` is
     /// popped first: the best distance of a nearest-triangle search then shrinks early
     /// and prunes more.
-    fn push_children_nearer_last(
-        &self,
-        node: &Node,
-        p: P3,
-        stack: &mut NodeStack,
-    ) {
+    fn push_children_nearer_last(&self, node: &Node, p: P3, stack: &mut NodeStack) {
         let (l, r) = (node.first, node.first + 1);
         let dl = self.nodes[l as usize].bounds.distance2(p);
         let dr = self.nodes[r as usize].bounds.distance2(p);

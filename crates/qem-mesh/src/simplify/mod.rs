@@ -159,19 +159,18 @@ pub fn simplify_levels(
     // the other core meanwhile (deterministic either way).
     // The store makes one face per cleaned triangle, in order, when none is refused;
     // the index seeds each face's search hint with its own triangle.
-    let faces_in_order: Vec<FaceKey> = if options.orientation_check
-        && engine.store.face_count() == cleaned.mesh.triangles.len()
-    {
-        engine.store.faces().collect()
-    } else {
-        Vec::new()
-    };
+    let faces_in_order: Vec<FaceKey> =
+        if options.orientation_check && engine.store.face_count() == cleaned.mesh.triangles.len() {
+            engine.store.faces().collect()
+        } else {
+            Vec::new()
+        };
     let ((), input_surface) = rayon::join(
         || engine.initialise(&cleaned.mesh, &keys, &locked, options),
         || {
-            options.orientation_check.then(|| {
-                orientation::InputSurface::new(&cleaned.mesh, &frame, &faces_in_order)
-            })
+            options
+                .orientation_check
+                .then(|| orientation::InputSurface::new(&cleaned.mesh, &frame, &faces_in_order))
         },
     );
     drop(faces_in_order);
