@@ -608,6 +608,23 @@ impl TriangleBvh {
         max_count: usize,
         out: &mut Vec<u32>,
     ) -> Option<u32> {
+        self.nearest_triangles_within(p, f64::INFINITY, factor, margin, max_count, out)
+    }
+
+    /// [`nearest_triangles`](Self::nearest_triangles) for a caller that already
+    /// knows a triangle at squared distance `known2` from `p` (the distance of some
+    /// triangle of this index, as [`distance_squared_to`](Self::distance_squared_to)
+    /// gives it; `f64::INFINITY` when none is known). The answer is the same; the
+    /// search prunes by that distance from the start instead of from its first leaf.
+    pub fn nearest_triangles_within(
+        &self,
+        p: [f64; 3],
+        known2: f64,
+        factor: f64,
+        margin: f64,
+        max_count: usize,
+        out: &mut Vec<u32>,
+    ) -> Option<u32> {
         out.clear();
         if self.corners.is_empty() {
             return None;
@@ -618,7 +635,9 @@ impl TriangleBvh {
             let d = best2.sqrt() * factor + margin;
             d * d * PRUNE_FACTOR + self.slack2
         };
-        let mut best2 = f64::INFINITY;
+        // Never below a true distance: the known triangle is found again (its leaf is
+        // within this bound), so the search ends with the same nearest distance.
+        let mut best2 = if known2 >= 0.0 { known2 } else { f64::INFINITY };
         // The nearest found so far, sorted by (squared distance, index), at most
         // `max_count` long (and at least 1, to know the nearest).
         let keep = max_count.max(1);

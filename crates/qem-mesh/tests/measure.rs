@@ -331,6 +331,30 @@ proptest! {
         }
     }
 
+    /// `nearest_triangles_within`, told the distance of any one triangle (as
+    /// `distance_squared_to` gives it), answers exactly as `nearest_triangles`.
+    #[test]
+    fn nearest_triangles_within_a_known_distance_answer_the_same(
+        mesh in soup(),
+        queries in proptest::collection::vec((point(), any::<proptest::sample::Index>()), 1..20),
+        factor in 1.0f64..2.0,
+        margin in prop_oneof![Just(0.0), 0.0f64..0.5],
+        max_count in prop_oneof![Just(usize::MAX), 0usize..10],
+    ) {
+        let bvh = TriangleBvh::new(&mesh);
+        let (mut near, mut near_within) = (Vec::new(), Vec::new());
+        for (p, known) in queries {
+            let known = known.index(bvh.triangle_count()) as u32;
+            let known2 = bvh.distance_squared_to(p, known).unwrap();
+            let nearest = bvh.nearest_triangles(p, factor, margin, max_count, &mut near);
+            let within = bvh.nearest_triangles_within(
+                p, known2, factor, margin, max_count, &mut near_within,
+            );
+            prop_assert_eq!(nearest, within);
+            prop_assert_eq!(&near, &near_within);
+        }
+    }
+
     /// `any_facing_away` answers exactly what a brute force over every triangle within
     /// the radius answers, up to the documented widening: it may see a triangle a
     /// rounding error beyond the radius, never miss one inside it. Normals include NaN

@@ -115,7 +115,8 @@ impl InputSurface {
         let centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
         let hint = self.hints.get(face).copied().or(*neighbour_hint);
         *neighbour_hint = hint;
-        if let Some(u2) = hint.and_then(|h| self.bvh.distance_squared_to(centroid.to_array(), h)) {
+        let known2 = hint.and_then(|h| self.bvh.distance_squared_to(centroid.to_array(), h));
+        if let Some(u2) = known2 {
             let radius = (u2.sqrt() * NEAR_FACTOR + NEAR_MARGIN) * QUICK_RADIUS_FACTOR;
             if radius.is_finite()
                 && !self.bvh.any_facing_away(
@@ -129,8 +130,9 @@ impl InputSurface {
             }
         }
 
-        let nearest = self.bvh.nearest_triangles(
+        let nearest = self.bvh.nearest_triangles_within(
             centroid.to_array(),
+            known2.unwrap_or(f64::INFINITY),
             NEAR_FACTOR,
             NEAR_MARGIN,
             NEAR_COUNT,
