@@ -53,9 +53,11 @@ pub(super) struct InputSurface {
     normal_bounds: NormalBounds,
     /// Reused query result.
     near: Vec<u32>,
-    /// The input triangle nearest to each face at its last full test. Its distance to
-    /// the face's new centroid bounds the nearest distance from above, which is what
-    /// the quick test needs.
+    /// Per face, an input triangle near it: at first the face's own input triangle,
+    /// then the nearest one at the face's last full test. Its distance to the face's
+    /// new centroid bounds the nearest distance from above, which is what the quick
+    /// test needs (and lets the full test prune from its first node). Any triangle
+    /// would give the same answers; a nearer one gives them sooner.
     hints: SecondaryMap<FaceKey, u32>,
 }
 
@@ -99,8 +101,8 @@ impl InputSurface {
     /// Whether face `face`, moved to these corners (normalised units), faces the same
     /// way as every input triangle nearest to its centroid.
     ///
-    /// Two ways to the same answer. The quick test: if the triangle nearest to this face
-    /// at its last full test is at distance `u` from the new centroid, the nearest
+    /// Two ways to the same answer. The quick test: if the face's hint triangle (see
+    /// `hints`) is at distance `u` from the new centroid, the nearest
     /// distance `d` is at most `u`, so every triangle the full test would ask lies
     /// within `NEAR_FACTOR·u + NEAR_MARGIN`; if no triangle in that ball faces away
     /// (a search that skips whole subtrees whose normals all agree), the answer is yes.
