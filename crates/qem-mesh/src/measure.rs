@@ -443,8 +443,11 @@ impl TriangleBvh {
     /// The index over these triangles (given by their corners), and where each went:
     /// `slots[i]` is the index (for [`corners`](Self::corners)) of `corners[i]`. Takes
     /// the corners by value and reorders them in place, so the build needs no second
-    /// copy (a large mesh's corners are 72 bytes per triangle).
+    /// copy (a large mesh's corners are 72 bytes per triangle). Triangles are numbered
+    /// with `u32`: at most `u32::MAX` of them are indexed (about 300 GB of corners), the
+    /// rest are left out.
     pub fn from_corners(mut corners: Vec<[P3; 3]>) -> (TriangleBvh, Vec<u32>) {
+        corners.truncate(u32::MAX as usize);
         // Kept for the build only (24 bytes per triangle): recomputing them inside the
         // median selection's comparisons made the dragon's index build about 0.3 s
         // slower, and the build is on the critical path of the setup.
@@ -599,7 +602,7 @@ impl TriangleBvh {
     /// must hear from all of them. Why a count: above a finely cut region the ball can
     /// hold hundreds of triangles, and the count keeps the search's cost bounded (the
     /// pruning radius shrinks to the `max_count`-th distance). `factor` below 1 counts
-    /// as 1.
+    /// as 1, and a negative (or NaN) `margin` as 0.
     pub fn nearest_triangles(
         &self,
         p: [f64; 3],
@@ -630,13 +633,18 @@ impl TriangleBvh {
             return None;
         }
         let factor = factor.max(1.0);
+        // A negative margin would make the bound smaller than the nearest distance
+        // itself (and the answer empty); NaN counts as 0 too.
+        let margin = margin.max(0.0);
         // The bound a triangle must meet, from the best squared distance so far.
         let bound = |best2: f64| {
             let d = best2.sqrt() * factor + margin;
             d * d * PRUNE_FACTOR + self.slack2
         };
-        // Never below a true distance: the known triangle is found again (its leaf is
-        // within this bound), so the search ends with the same nearest distance.
+        // Why starting from `known2` changes nothing: it is a true squared distance, so
+        // `best2` never drops below the nearest triangle's squared distance, and every
+        // pruning bound stays at or above it; the nearest triangle's node is never
+        // skipped, and `best2` ends at its distance from either start.
         let mut best2 = if known2 >= 0.0 { known2 } else { f64::INFINITY };
         // The nearest found so far, sorted by (squared distance, index), at most
         // `max_count` long (and at least 1, to know the nearest).

@@ -64,6 +64,46 @@ fn cube() -> IndexedMesh {
     IndexedMesh::new(positions, triangles)
 }
 
+/// A negative margin counts as 0, so the nearest triangle is always in the answer,
+/// with or without a known distance to start from (a review found `None` for margins
+/// below 0 before they were clamped).
+#[test]
+fn a_negative_margin_still_finds_the_nearest_triangle() {
+    // Two triangles in planes z = 1 and z = 3 above the query point at the origin.
+    let mesh = IndexedMesh::new(
+        vec![
+            [-1.0, -1.0, 1.0],
+            [1.0, -1.0, 1.0],
+            [0.0, 1.0, 1.0],
+            [-1.0, -1.0, 3.0],
+            [1.0, -1.0, 3.0],
+            [0.0, 1.0, 3.0],
+        ],
+        vec![[0, 1, 2], [3, 4, 5]],
+    );
+    let bvh = TriangleBvh::new(&mesh);
+    let p = [0.0, 0.0, 0.0];
+    let far = (0..2u32)
+        .max_by(|&x, &y| {
+            let dx = bvh.distance_squared_to(p, x).unwrap();
+            let dy = bvh.distance_squared_to(p, y).unwrap();
+            dx.total_cmp(&dy)
+        })
+        .unwrap();
+    let far2 = bvh.distance_squared_to(p, far).unwrap();
+    assert_eq!(far2, 9.0);
+    for margin in [-2.5, -0.5, f64::NAN] {
+        let (mut plain, mut within) = (Vec::new(), Vec::new());
+        let a = bvh.nearest_triangles(p, 1.0, margin, 8, &mut plain);
+        let b = bvh.nearest_triangles_within(p, far2, 1.0, margin, 8, &mut within);
+        assert!(a.is_some(), "margin {margin}");
+        assert_ne!(a, Some(far), "margin {margin}");
+        assert_eq!(a, b, "margin {margin}");
+        assert_eq!(plain.len(), 1, "margin {margin}");
+        assert_eq!(plain, within, "margin {margin}");
+    }
+}
+
 #[test]
 fn identical_meshes_are_at_distance_zero() {
     for mesh in [grid(7, 0.3), cube()] {

@@ -12,6 +12,10 @@
 //! 3. the edges of `b` are re-pointed to `a`, or merged into `a`'s edge to the same
 //!    neighbour, fans joined. No face can be in both fans (it would contain `a` and `b`
 //!    and was removed in step 1), so joining is a plain append.
+//!
+//! Contraction only removes and re-points elements; it never inserts one. The store's
+//! records hold 32-bit slot indices on the ground that no slot is ever reused (see
+//! `MeshStore`); an insertion here would break that.
 
 use super::{ordered_packed, remove_item, EdgeKey, FaceKey, MeshStore, Packed, VertexKey};
 

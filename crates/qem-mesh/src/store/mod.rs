@@ -232,6 +232,11 @@ struct Scratch {
 ///
 /// Everything is deterministic: the same input and the same sequence of operations give
 /// the same keys, the same iteration order and the same output, bit for bit.
+///
+/// Elements are inserted only by [`from_mesh`](MeshStore::from_mesh) and only removed
+/// afterwards, so no slot is ever reused: the records hold 32-bit slot indices instead
+/// of keys on that ground (see `Packed`). An operation that inserts after the build
+/// must first give that up.
 #[derive(Clone, Debug, Default)]
 pub struct MeshStore {
     vertices: SlotMap<VertexKey, Vertex>,

@@ -185,9 +185,11 @@ impl MeshStore {
     /// If `v` is not in the store.
     pub fn faces_of_vertex(&self, v: VertexKey, out: &mut Vec<FaceKey>) {
         out.clear();
-        // Both keys are live (indexing checked them), so comparing indices is exact.
+        // Indexing checks that `v` is live before it is packed; star edges are live.
+        // Both keys live, comparing indices is exact.
+        let star = &self.vertices[v].star;
         let packed_v = Packed::new(v);
-        for &e in &self.vertices[v].star {
+        for &e in star {
             let packed_e = Packed::new(e);
             for &f in self.fan(e) {
                 // A face at v appears in the fans of two star edges; taking it only at the
