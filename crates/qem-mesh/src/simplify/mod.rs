@@ -155,16 +155,16 @@ pub fn simplify_levels(
     let frame = Frame::from_points(cleaned.mesh.positions.iter().map(|p| DVec3::from_array(*p)));
     let mut engine = Engine::new(store, frame, options);
     let clock = Instant::now();
-    // The orientation check's index is independent of the quadrics and queue: built on
-    // the other core meanwhile (deterministic either way).
     // The store makes one face per cleaned triangle, in order, when none is refused;
-    // the index seeds each face's search hint with its own triangle.
+    // the orientation check's index seeds each face's search hint with its own triangle.
     let faces_in_order: Vec<FaceKey> =
         if options.orientation_check && engine.store.face_count() == cleaned.mesh.triangles.len() {
             engine.store.faces().collect()
         } else {
             Vec::new()
         };
+    // The orientation check's index is independent of the quadrics and queue: built on
+    // the other core meanwhile (deterministic either way).
     let ((), input_surface) = rayon::join(
         || engine.initialise(&cleaned.mesh, &keys, &locked, options),
         || {
