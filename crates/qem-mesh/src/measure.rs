@@ -40,7 +40,10 @@
 //! assert!(m.samples_ab >= 1000);
 //! ```
 
+mod facing;
+
 use crate::input::{IndexedMesh, InputError};
+pub use facing::FacingTree;
 use rayon::prelude::*;
 use std::fmt;
 
@@ -354,8 +357,10 @@ impl Aabb {
 /// and pop (its inline-or-spilled checks) were 12% of the contraction loop's
 /// instructions through the orientation check's quick test. Why 64 is enough: the tree
 /// splits at the median, so a node `d` levels down holds at most `n / 2^d + 1`
-/// triangles and the depth stays below 33 for any `n < 2^32`; a walk pops one node for
-/// every two it pushes, so it never holds more than depth + 1 entries.
+/// triangles and the depth stays below 33 for any `n < 2^32`; a walk of the binary tree
+/// pops one node for every two it pushes, so it never holds more than depth + 1
+/// entries, and a walk of the [`FacingTree`] (four children a node, two binary levels
+/// each, so at most 17 deep) pushes at most four per pop: at most 3 × 17 + 1 = 52.
 struct NodeStack {
     items: [u32; 64],
     len: usize,
@@ -706,89 +711,6 @@ impl TriangleBvh {
         Some(triangle_distance2(p, *a, *b, *c))
     }
 
-    /// Per-node bounds of the triangles' unit normals, for
-    /// [`any_facing_away`](Self::any_facing_away). Built bottom-up in O(n).
-    pub fn normal_bounds(&self) -> NormalBounds {
-        let mut boxes = vec![Aabb::EMPTY; self.nodes.len()];
-        // Children always have higher indices than their parent (see `new`), so a
-        // reverse sweep sees both children before the parent.
-        for n in (0..self.nodes.len()).rev() {
-            let node = self.nodes[n];
-            let mut bounds = Aabb::EMPTY;
-            if node.count > 0 {
-                let start = node.first as usize;
-                for [a, b, c] in &self.corners[start..start + node.count as usize] {
-                    let normal = cross(sub(*b, *a), sub(*c, *a));
-                    let length = length(normal);
-                    if length > 0.0 && length.is_finite() {
-                        bounds.grow(normal.map(|x| x / length));
-                    } else if normal != [0.0; 3] {
-                        // A direction whose length under- or overflows (or is NaN):
-                        // any direction, so the subtree is never skipped for it.
-                        bounds.grow([-1.0; 3]);
-                        bounds.grow([1.0; 3]);
-                    }
-                    // An exactly zero normal (zero area) has no direction and no say.
-                }
-            } else {
-                for child in [node.first as usize, node.first as usize + 1] {
-                    bounds.grow(boxes[child].lo);
-                    bounds.grow(boxes[child].hi);
-                }
-            }
-            boxes[n] = bounds;
-        }
-        NormalBounds { boxes }
-    }
-
-    /// Whether some triangle within `radius` of `p` faces away from `normal`: its normal
-    /// has a dot product ≤ 0 with `normal` (zero-area triangles excepted). A subtree
-    /// whose normals all face the same way as `normal` (by `bounds`, from
-    /// [`normal_bounds`](Self::normal_bounds) of this index) is skipped whole, so on a
-    /// smooth patch the search ends well above the leaves.
-    ///
-    /// May also answer true for a triangle a rounding error beyond `radius` (the box
-    /// tests are widened, never narrowed); never answers false wrongly.
-    pub fn any_facing_away(
-        &self,
-        bounds: &NormalBounds,
-        p: [f64; 3],
-        radius: f64,
-        normal: [f64; 3],
-    ) -> bool {
-        if self.corners.is_empty() || bounds.boxes.len() != self.nodes.len() {
-            return !self.corners.is_empty();
-        }
-        let radius2 = radius * radius * PRUNE_FACTOR + self.slack2;
-        let unit = unit_direction(normal);
-        let mut stack = NodeStack::with_root();
-        while let Some(n) = stack.pop() {
-            let node = &self.nodes[n as usize];
-            if node.bounds.distance2(p) > radius2 || unit.is_some_and(|u| bounds.all_face(n, u)) {
-                continue;
-            }
-            if node.count > 0 {
-                let start = node.first as usize;
-                for [a, b, c] in &self.corners[start..start + node.count as usize] {
-                    let t = cross(sub(*b, *a), sub(*c, *a));
-                    // "Not positive", NaN included, exactly as the caller's full test
-                    // asks it (a zero normal has no say there either).
-                    let d = dot(t, normal);
-                    if (d <= 0.0 || d.is_nan())
-                        && t != [0.0; 3]
-                        && triangle_distance2(p, *a, *b, *c) <= radius2
-                    {
-                        return true;
-                    }
-                }
-            } else {
-                stack.push(node.first);
-                stack.push(node.first + 1);
-            }
-        }
-        false
-    }
-
     /// Number of indexed triangles (those of the mesh with valid indices); indices for
     /// [`corners`](Self::corners) run below it.
     pub fn triangle_count(&self) -> usize {
@@ -800,50 +722,6 @@ impl TriangleBvh {
     pub fn corners(&self, i: u32) -> [[f64; 3]; 3] {
         self.corners[i as usize]
     }
-}
-
-/// Bounds of the unit normals under each node of a [`TriangleBvh`], from
-/// [`TriangleBvh::normal_bounds`].
-#[derive(Clone, Debug)]
-pub struct NormalBounds {
-    boxes: Vec<Aabb>,
-}
-
-/// How far above zero the lower bound of a dot product must be before a whole subtree
-/// counts as facing the same way: far above the rounding of unit normals (about 1e-16),
-/// so that rounding never hides a triangle at right angles.
-const FACING_MARGIN: f64 = 1e-9;
-
-impl NormalBounds {
-    /// Whether every unit normal under node `n` has a positive dot product with the
-    /// unit vector `unit`, by the least value of `x·unit` over the node's box of normals (a
-    /// lower bound, since the unit normals lie in the box). An empty box (only
-    /// zero-area triangles) faces every way.
-    #[inline]
-    fn all_face(&self, n: u32, unit: [f64; 3]) -> bool {
-        let b = &self.boxes[n as usize];
-        if b.lo[0] > b.hi[0] {
-            return true;
-        }
-        let least: f64 = (0..3)
-            .map(|k| {
-                if unit[k] >= 0.0 {
-                    unit[k] * b.lo[k]
-                } else {
-                    unit[k] * b.hi[k]
-                }
-            })
-            .sum();
-        least > FACING_MARGIN
-    }
-}
-
-/// `v` scaled to unit length, or `None` when its length is zero, NaN or infinite (such
-/// a direction is never known to agree with a box of normals, so no subtree is skipped
-/// for it).
-fn unit_direction(v: P3) -> Option<P3> {
-    let length = length(v);
-    (length > 0.0 && length.is_finite()).then(|| v.map(|x| x / length))
 }
 
 /// The exact distance from `p` to the nearest triangle of `mesh`, by testing every

@@ -16,7 +16,7 @@
 //! nearest distance, so a centroid over a crease hears from both sides) and refuse if
 //! any of them faces away (normal dot product ≤ 0).
 
-use crate::measure::{NormalBounds, TriangleBvh};
+use crate::measure::{FacingTree, TriangleBvh};
 use crate::store::FaceKey;
 use crate::IndexedMesh;
 use qem_core::{DVec3, Frame};
@@ -49,8 +49,8 @@ const QUICK_RADIUS_FACTOR: f64 = 1.0 + 1e-9;
 #[derive(Debug)]
 pub(super) struct InputSurface {
     bvh: TriangleBvh,
-    /// Per-node bounds of the unit normals, for the quick test.
-    normal_bounds: NormalBounds,
+    /// The index's boxes laid out for the quick test.
+    facing_tree: FacingTree,
     /// Reused query result.
     near: Vec<u32>,
     /// Per face, an input triangle near it: at first the face's own input triangle,
@@ -91,7 +91,7 @@ impl InputSurface {
             }
         }
         InputSurface {
-            normal_bounds: bvh.normal_bounds(),
+            facing_tree: bvh.facing_tree(),
             bvh,
             near: Vec::new(),
             hints,
@@ -122,7 +122,7 @@ impl InputSurface {
             let radius = (u2.sqrt() * NEAR_FACTOR + NEAR_MARGIN) * QUICK_RADIUS_FACTOR;
             if radius.is_finite()
                 && !self.bvh.any_facing_away(
-                    &self.normal_bounds,
+                    &self.facing_tree,
                     centroid.to_array(),
                     radius,
                     normal.to_array(),
