@@ -22,11 +22,13 @@
 #![forbid(unsafe_code)]
 
 mod frame;
+mod plane;
 mod quadric;
 mod solve;
 
 pub use frame::Frame;
 pub use glam::DVec3;
+pub use plane::WeightedPlane;
 pub use quadric::{unit_normal_and_area, Quadric};
 pub use solve::{
     endpoint_placement, minimize, optimal_placement, segment_placement, Placement, PlacementRule,

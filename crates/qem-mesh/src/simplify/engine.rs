@@ -13,7 +13,7 @@ use crate::store::{EdgeKey, FaceKey, MeshStore, VertexKey};
 use crate::IndexedMesh;
 use qem_core::{
     endpoint_placement, optimal_placement, unit_normal_and_area, DVec3, Frame, Placement,
-    PlacementRule, Quadric,
+    PlacementRule, Quadric, WeightedPlane,
 };
 use slotmap::{Key, SecondaryMap};
 use smallvec::SmallVec;
@@ -347,17 +347,18 @@ impl Engine {
                 self.normalized_position(c),
             );
             self.original_normals.insert(f, (pb - pa).cross(pc - pa));
-            let q = match area_offset {
-                Some(extra) => Quadric::from_triangle_area_plus(pa, pb, pc, extra),
-                None => Quadric::from_triangle_unweighted(pa, pb, pc),
+            let plane = match area_offset {
+                Some(extra) => WeightedPlane::from_triangle_area_plus(pa, pb, pc, extra),
+                None => WeightedPlane::from_triangle_unweighted(pa, pb, pc),
             };
+            let q = plane.quadric();
             for v in [a, b, c] {
                 if let Some(s) = self.state.get_mut(v) {
                     s.quadric += q;
                 }
             }
             if let Some(exact) = &mut self.exact {
-                exact.add_face(f, self.store.face_edges(f), q);
+                exact.add_face(f, self.store.face_edges(f), plane, q);
             }
         }
         self.initialise_boundary(options, area_offset);

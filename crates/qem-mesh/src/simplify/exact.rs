@@ -32,16 +32,34 @@
 //! from `a` and `b` keep their quadrics: their groups did not change.
 
 use crate::store::{ContractError, ContractLog, EdgeKey, FaceKey, MeshStore, VertexKey};
-use qem_core::Quadric;
-use slotmap::SecondaryMap;
+use qem_core::{Quadric, WeightedPlane};
+use slotmap::Key;
+use std::collections::HashMap;
+
+/// The slot index of a store key. Why slot-indexed vectors rather than `SecondaryMap`s:
+/// the store never reuses a slot, so the versions a `SecondaryMap` keeps (8 bytes an
+/// entry, with padding) would tell nothing apart; on a 4M-triangle mesh they were 80 MB.
+fn slot<K: Key>(key: K) -> usize {
+    key.data().as_ffi() as u32 as usize
+}
 
 /// Intersection quadrics on edges and faces, and the buffers of one contraction.
+///
+/// Entries are by the key's slot index and are read only for live keys (the loop never
+/// asks about a removed edge or face); a removed entry is set to zero, so a stale read
+/// would see no plane rather than an old one.
 #[derive(Debug, Default)]
 pub(super) struct ExactQuadrics {
     /// `Q_ab` for every live edge `a–b`.
-    edges: SecondaryMap<EdgeKey, Quadric>,
-    /// `Q_abc` for every live face: the planes of the original faces now on it.
-    faces: SecondaryMap<FaceKey, Quadric>,
+    edges: Vec<Quadric>,
+    /// The plane of the input face on each face: its `Q_abc` while no other face has
+    /// merged into it. Why planes (40 bytes) rather than quadrics (80): a face's quadric
+    /// is read only when it collapses or merges, about twice per contraction, and was
+    /// 350 MB on a 4M-triangle mesh.
+    face_planes: Vec<WeightedPlane>,
+    /// `Q_abc` of the faces that duplicates merged into (no longer one plane), by
+    /// slot. Rare: only duplicate faces merge. Only looked up, never iterated.
+    merged_faces: HashMap<usize, Quadric>,
     /// What the store merged, reused across contractions.
     log: ContractLog,
     /// The third vertex and quadric of each face on the contracted edge, taken before
@@ -52,21 +70,24 @@ pub(super) struct ExactQuadrics {
 impl ExactQuadrics {
     /// Zero quadrics on every edge of `store`, room for every face.
     pub fn new(store: &MeshStore) -> Self {
-        let mut edges = SecondaryMap::with_capacity(store.edge_count());
-        for e in store.edges() {
-            edges.insert(e, Quadric::ZERO);
-        }
+        let edge_slots = store.edges().map(|e| slot(e) + 1).max().unwrap_or(0);
+        let face_slots = store.faces().map(|f| slot(f) + 1).max().unwrap_or(0);
         ExactQuadrics {
-            edges,
-            faces: SecondaryMap::with_capacity(store.face_count()),
+            edges: vec![Quadric::ZERO; edge_slots],
+            face_planes: vec![WeightedPlane::NONE; face_slots],
+            merged_faces: HashMap::new(),
             log: ContractLog::default(),
             collapsed: Vec::new(),
         }
     }
 
-    /// Records the plane `q` of face `f`, whose edges are `edges`.
-    pub fn add_face(&mut self, f: FaceKey, edges: [EdgeKey; 3], q: Quadric) {
-        self.faces.insert(f, q);
+    /// Records `plane`, the plane of face `f`, whose edges are `edges`; `q` is its
+    /// quadric (`plane.quadric()`, which the caller has already computed).
+    pub fn add_face(&mut self, f: FaceKey, edges: [EdgeKey; 3], plane: WeightedPlane, q: Quadric) {
+        debug_assert_eq!(plane.quadric(), q);
+        if let Some(entry) = self.face_planes.get_mut(slot(f)) {
+            *entry = plane;
+        }
         for e in edges {
             self.add_edge_plane(e, q);
         }
@@ -74,15 +95,15 @@ impl ExactQuadrics {
 
     /// Records a plane supported by the two ends of edge `e` (a border plane).
     pub fn add_edge_plane(&mut self, e: EdgeKey, q: Quadric) {
-        if let Some(sum) = self.edges.get_mut(e) {
+        if let Some(sum) = self.edges.get_mut(slot(e)) {
             *sum += q;
         }
     }
 
-    /// `Q_ab` of edge `e`, or zero for a pair without edge.
+    /// `Q_ab` of edge `e` (live), or zero for a pair without edge.
     #[inline]
     pub fn edge(&self, e: Option<EdgeKey>) -> Quadric {
-        e.and_then(|e| self.edges.get(e).copied())
+        e.and_then(|e| self.edges.get(slot(e)).copied())
             .unwrap_or(Quadric::ZERO)
     }
 
@@ -98,27 +119,30 @@ impl ExactQuadrics {
     ) -> Result<(), ContractError> {
         let ExactQuadrics {
             edges,
-            faces,
+            face_planes,
+            merged_faces,
             log,
             collapsed,
         } = self;
         collapsed.clear();
         if let Some(ab) = ab.filter(|&e| store.contains_edge(e)) {
             for &f in store.fan(ab) {
-                if let (Some(x), Some(&q)) = (store.opposite_vertex(f, ab), faces.get(f)) {
-                    collapsed.push((x, q));
+                if let Some(x) = store.opposite_vertex(f, ab) {
+                    collapsed.push((x, face_quadric(face_planes, merged_faces, f)));
                 }
             }
         }
         store.contract_along(a, b, ab, position, Some(log))?;
         for &(removed, kept) in &log.faces_merged {
-            let q = faces.remove(removed).unwrap_or(Quadric::ZERO);
-            if let Some(sum) = faces.get_mut(kept) {
-                *sum += q;
-            }
+            let q = face_quadric(face_planes, merged_faces, removed);
+            let sum = face_quadric(face_planes, merged_faces, kept) + q;
+            merged_faces.insert(slot(kept), sum);
+            forget_face(face_planes, merged_faces, removed);
         }
         for &(removed, kept) in &log.edges_merged {
-            let q_bx = edges.remove(removed).unwrap_or(Quadric::ZERO);
+            let q_bx = edges
+                .get_mut(slot(removed))
+                .map_or(Quadric::ZERO, std::mem::take);
             let Some(x) = store.other_vertex(kept, a) else {
                 continue;
             };
@@ -128,16 +152,47 @@ impl ExactQuadrics {
                 .iter()
                 .find(|(y, _)| *y == x)
                 .map_or(Quadric::ZERO, |(_, q)| *q);
-            if let Some(sum) = edges.get_mut(kept) {
+            if let Some(sum) = edges.get_mut(slot(kept)) {
                 *sum += q_bx - q_abx;
             }
         }
         for &f in &log.faces_collapsed {
-            faces.remove(f);
+            forget_face(face_planes, merged_faces, f);
         }
         if let Some(e) = log.edge_collapsed {
-            edges.remove(e);
+            if let Some(q) = edges.get_mut(slot(e)) {
+                *q = Quadric::ZERO;
+            }
         }
         Ok(())
     }
+}
+
+/// `Q_abc` of live face `f`: the sum kept for it if faces merged into it, else its
+/// input face's plane.
+fn face_quadric(
+    face_planes: &[WeightedPlane],
+    merged_faces: &HashMap<usize, Quadric>,
+    f: FaceKey,
+) -> Quadric {
+    let i = slot(f);
+    match merged_faces.get(&i) {
+        Some(&q) => q,
+        None => face_planes
+            .get(i)
+            .map_or(Quadric::ZERO, WeightedPlane::quadric),
+    }
+}
+
+/// Clears the entries of removed face `f`.
+fn forget_face(
+    face_planes: &mut [WeightedPlane],
+    merged_faces: &mut HashMap<usize, Quadric>,
+    f: FaceKey,
+) {
+    let i = slot(f);
+    if let Some(plane) = face_planes.get_mut(i) {
+        *plane = WeightedPlane::NONE;
+    }
+    merged_faces.remove(&i);
 }
