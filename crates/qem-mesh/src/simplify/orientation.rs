@@ -16,7 +16,7 @@
 //! nearest distance, so a centroid over a crease hears from both sides) and refuse if
 //! any of them faces away (normal dot product ≤ 0).
 
-use crate::measure::{FacingTree, TriangleBvh};
+use crate::measure::TriangleBvh;
 use crate::store::FaceKey;
 use crate::IndexedMesh;
 use qem_core::{DVec3, Frame};
@@ -49,8 +49,6 @@ const QUICK_RADIUS_FACTOR: f64 = 1.0 + 1e-9;
 #[derive(Debug)]
 pub(super) struct InputSurface {
     bvh: TriangleBvh,
-    /// The index's boxes laid out for the quick test.
-    facing_tree: FacingTree,
     /// Reused query result.
     near: Vec<u32>,
     /// Per face, an input triangle near it: at first the face's own input triangle,
@@ -91,7 +89,6 @@ impl InputSurface {
             }
         }
         InputSurface {
-            facing_tree: bvh.facing_tree(),
             bvh,
             near: Vec::new(),
             hints,
@@ -121,12 +118,9 @@ impl InputSurface {
         if let Some(u2) = known2 {
             let radius = (u2.sqrt() * NEAR_FACTOR + NEAR_MARGIN) * QUICK_RADIUS_FACTOR;
             if radius.is_finite()
-                && !self.bvh.any_facing_away(
-                    &self.facing_tree,
-                    centroid.to_array(),
-                    radius,
-                    normal.to_array(),
-                )
+                && !self
+                    .bvh
+                    .any_facing_away(centroid.to_array(), radius, normal.to_array())
             {
                 return true;
             }

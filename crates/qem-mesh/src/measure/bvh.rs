@@ -1,0 +1,735 @@
+//! [`TriangleBvh`]: a bounding-volume hierarchy over the triangles of one mesh, for
+//! exact nearest-triangle queries (Metro sampling, the orientation check).
+//!
+//! Built as a binary tree (median splits), then stored as a 4-wide tree: each node
+//! holds its (up to) four children's boxes side by side in `f32`, by axis, two binary
+//! levels at once. Why: a walk reads one node (four cache lines) where it read four
+//! binary nodes in as many places, tests four boxes with the same instructions, and a
+//! node costs about 54 bytes per child instead of 56 for the binary node plus 48 for
+//! its normal box. The binary tree is dropped once the wide one is built.
+//!
+//! Why `f32` boxes change no answer: every box is rounded outward, so the distance to
+//! it is never more than the distance to the exact box, and a subtree is skipped only
+//! when it is farther than the pruning bound; the answers themselves come from the
+//! exact `f64` triangle distances at the leaves.
+
+use super::{cross, length, sub, triangle_distance2, P3};
+use crate::input::IndexedMesh;
+
+/// Triangles per leaf: small leaves keep the exact tests few, large enough to keep the
+/// tree shallow.
+const LEAF_SIZE: usize = 4;
+
+/// Children per node of the stored tree.
+pub(super) const WIDTH: usize = 4;
+
+/// A node is skipped only when its box is farther than the best squared distance by more
+/// than this factor (plus [`TriangleBvh::slack2`]): a margin far above the rounding of
+/// either computation, so rounding can never skip the node that holds the triangle a
+/// brute-force search would pick. It costs a handful of extra box tests.
+pub(super) const PRUNE_FACTOR: f64 = 1.0 + 1e-9;
+
+/// An axis-aligned box in `f64`, for the build.
+#[derive(Clone, Copy, Debug)]
+struct Aabb {
+    lo: P3,
+    hi: P3,
+}
+
+impl Aabb {
+    const EMPTY: Aabb = Aabb {
+        lo: [f64::INFINITY; 3],
+        hi: [f64::NEG_INFINITY; 3],
+    };
+
+    fn grow(&mut self, p: P3) {
+        for (k, &x) in p.iter().enumerate() {
+            self.lo[k] = self.lo[k].min(x);
+            self.hi[k] = self.hi[k].max(x);
+        }
+    }
+}
+
+/// A node of the binary tree, for the build.
+#[derive(Clone, Copy, Debug)]
+struct BinaryNode {
+    bounds: Aabb,
+    /// Leaf: start in `order`; inner: index of the first child (the second follows it).
+    first: u32,
+    /// Leaf: number of triangles (> 0); inner: 0.
+    count: u32,
+}
+
+/// `x` rounded to an `f32` at or below it (−∞ and +∞ stay).
+pub(super) fn f32_below(x: f64) -> f32 {
+    let f = x as f32;
+    if f64::from(f) > x {
+        step_toward_negative(f)
+    } else {
+        f
+    }
+}
+
+/// `x` rounded to an `f32` at or above it.
+pub(super) fn f32_above(x: f64) -> f32 {
+    -f32_below(-x)
+}
+
+/// The next `f32` below `f` (finite or +∞). (`f32::next_down` is newer than the
+/// workspace's minimum Rust version.)
+fn step_toward_negative(f: f32) -> f32 {
+    if f == 0.0 {
+        -f32::from_bits(1)
+    } else if f > 0.0 {
+        f32::from_bits(f.to_bits() - 1)
+    } else {
+        f32::from_bits(f.to_bits() + 1)
+    }
+}
+
+/// An axis-aligned box in `f32`, rounded outward from `f64` bounds.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Box32 {
+    pub lo: [f32; 3],
+    pub hi: [f32; 3],
+}
+
+impl Box32 {
+    /// Contains nothing: every test against it fails, and growing it by a box gives
+    /// that box.
+    pub const EMPTY: Box32 = Box32 {
+        lo: [f32::INFINITY; 3],
+        hi: [f32::NEG_INFINITY; 3],
+    };
+
+    pub fn around(lo: P3, hi: P3) -> Box32 {
+        Box32 {
+            lo: lo.map(f32_below),
+            hi: hi.map(f32_above),
+        }
+    }
+
+    fn grow(&mut self, other: &Box32) {
+        for k in 0..3 {
+            self.lo[k] = self.lo[k].min(other.lo[k]);
+            self.hi[k] = self.hi[k].max(other.hi[k]);
+        }
+    }
+}
+
+/// A node of the stored tree: its (up to) four children's boxes, by axis then child,
+/// so that each test reads four adjacent lanes.
+#[derive(Clone, Debug)]
+pub(super) struct WideNode {
+    /// Position boxes: `lo[k][i]` is the least `k` coordinate under child `i`.
+    pub lo: [[f32; WIDTH]; 3],
+    pub hi: [[f32; WIDTH]; 3],
+    /// Boxes of the unit normals under each child, for the orientation check's
+    /// facing-away search (empty when all its triangles have zero area).
+    pub normal_lo: [[f32; WIDTH]; 3],
+    pub normal_hi: [[f32; WIDTH]; 3],
+    /// An inner child: its node's index. A leaf child: the first of its triangles.
+    pub child: [u32; WIDTH],
+    /// A leaf child: how many triangles (1..=LEAF_SIZE); an inner child: 0.
+    pub leaf_count: [u8; WIDTH],
+    /// How many children are used (the first ones); the others have empty boxes.
+    pub lanes: u8,
+}
+
+impl WideNode {
+    /// No children: every box empty.
+    const EMPTY: WideNode = WideNode {
+        lo: [[f32::INFINITY; WIDTH]; 3],
+        hi: [[f32::NEG_INFINITY; WIDTH]; 3],
+        normal_lo: [[f32::INFINITY; WIDTH]; 3],
+        normal_hi: [[f32::NEG_INFINITY; WIDTH]; 3],
+        child: [u32::MAX; WIDTH],
+        leaf_count: [0; WIDTH],
+        lanes: 0,
+    };
+
+    pub(super) fn set_child(&mut self, i: usize, position: &Box32, normals: &Box32) {
+        for k in 0..3 {
+            self.lo[k][i] = position.lo[k];
+            self.hi[k][i] = position.hi[k];
+            self.normal_lo[k][i] = normals.lo[k];
+            self.normal_hi[k][i] = normals.hi[k];
+        }
+    }
+
+    /// Squared distance from `p` to child `i`'s box (0 inside), in `f64` on the
+    /// outward-rounded bounds: a lower bound on the distance to anything under it.
+    /// Plain comparisons rather than `f64::max` (which must pass NaN over, at a few
+    /// instructions each): a NaN coordinate still gives 0 (every comparison with NaN
+    /// is false), so a NaN point prunes nothing, as before.
+    #[inline(always)]
+    fn lane_distance2(&self, i: usize, p: P3) -> f64 {
+        let mut s = 0.0;
+        for (k, &x) in p.iter().enumerate() {
+            let below = f64::from(self.lo[k][i]) - x;
+            let above = x - f64::from(self.hi[k][i]);
+            let outside = if below > above { below } else { above };
+            let d = if outside > 0.0 { outside } else { 0.0 };
+            s += d * d;
+        }
+        s
+    }
+}
+
+/// A stack of node indices (with a key, for the nearest-first walks) for the tree
+/// walks. Why a plain array: `SmallVec`'s push and pop (its inline-or-spilled checks)
+/// were 12% of the contraction loop's instructions through the orientation check's
+/// quick test. Why 64 is enough: the binary tree splits at the median, so a node `d`
+/// levels down holds at most `n / 2^d + 1` triangles and its depth stays below 33 for
+/// any `n < 2^32`; the wide tree is then at most 17 deep, and a walk pushes at most
+/// four children per node it pops: at most 3 × 17 + 1 = 52 entries.
+pub(super) struct NodeStack<T> {
+    items: [T; 64],
+    len: usize,
+}
+
+impl<T: Copy + Default> NodeStack<T> {
+    pub fn with(root: T) -> NodeStack<T> {
+        let mut items = [T::default(); 64];
+        items[0] = root;
+        NodeStack { items, len: 1 }
+    }
+
+    #[inline]
+    pub fn push(&mut self, item: T) {
+        self.items[self.len] = item;
+        self.len += 1;
+    }
+
+    #[inline]
+    pub fn pop(&mut self) -> Option<T> {
+        self.len = self.len.checked_sub(1)?;
+        Some(self.items[self.len])
+    }
+}
+
+/// A bounding-volume hierarchy over the triangles of one mesh, for exact closest-point
+/// queries: a node is skipped only when its box is farther than the best distance found
+/// so far, so the answer is the true minimum over all triangles.
+///
+/// Built top-down by splitting the triangles at the median centroid along the longest
+/// axis of the centroids' box (ties broken by triangle index, so the tree is
+/// deterministic), then stored four children a node (see the module docs).
+#[derive(Clone, Debug)]
+pub struct TriangleBvh {
+    /// The wide tree; node 0 is the root. Empty when there are no triangles.
+    pub(super) nodes: Vec<WideNode>,
+    /// Triangle corners in leaf order: the leaf's triangles are contiguous.
+    pub(super) corners: Vec<[P3; 3]>,
+    /// Absolute part of the pruning margin (squared): rounding of coordinates at the
+    /// scale of the whole tree.
+    pub(super) slack2: f64,
+}
+
+impl TriangleBvh {
+    /// Builds the hierarchy over every triangle of `mesh` (degenerate ones included:
+    /// their points are still on the surface). The mesh must pass
+    /// [`IndexedMesh::validate`]; an index out of range would otherwise be skipped.
+    pub fn new(mesh: &IndexedMesh) -> TriangleBvh {
+        Self::with_slots(mesh).0
+    }
+
+    /// [`new`](Self::new), and where each triangle went: `slots[i]` is the index (for
+    /// [`corners`](Self::corners)) of the `i`-th triangle of `mesh` with valid indices.
+    pub fn with_slots(mesh: &IndexedMesh) -> (TriangleBvh, Vec<u32>) {
+        let corners: Vec<[P3; 3]> = mesh
+            .triangles
+            .iter()
+            .filter_map(|t| {
+                let p = |i: u32| mesh.positions.get(i as usize).copied();
+                Some([p(t[0])?, p(t[1])?, p(t[2])?])
+            })
+            .collect();
+        Self::from_corners(corners)
+    }
+
+    /// The index over these triangles (given by their corners), and where each went:
+    /// `slots[i]` is the index (for [`corners`](Self::corners)) of `corners[i]`. Takes
+    /// the corners by value and reorders them in place, so the build needs no second
+    /// copy (a large mesh's corners are 72 bytes per triangle). Triangles are numbered
+    /// with `u32`: at most `u32::MAX` of them are indexed (about 300 GB of corners), the
+    /// rest are left out.
+    pub fn from_corners(mut corners: Vec<[P3; 3]>) -> (TriangleBvh, Vec<u32>) {
+        corners.truncate(u32::MAX as usize);
+        let (binary, slots) = build_binary(&mut corners);
+        let root = binary[0].bounds;
+        let scale = (0..3)
+            .map(|k| root.lo[k].abs().max(root.hi[k].abs()))
+            .fold(0.0, f64::max);
+        let slack = if scale.is_finite() {
+            1e-12 * scale
+        } else {
+            0.0
+        };
+        let nodes = if corners.is_empty() {
+            Vec::new()
+        } else {
+            widen(&binary, &corners)
+        };
+        (
+            TriangleBvh {
+                nodes,
+                corners,
+                slack2: slack * slack,
+            },
+            slots,
+        )
+    }
+
+    /// Visits node `w` of a nearest-first walk: tests the triangles of its leaf
+    /// children, nearest child first, and pushes its inner children with their box
+    /// distances, farthest first (so the nearest is popped next). `prune` gives the
+    /// current bound on squared distances and `leaf` takes each triangle index of a leaf
+    /// child within it.
+    #[inline(always)]
+    fn visit_nearest_first(
+        &self,
+        w: u32,
+        p: P3,
+        stack: &mut NodeStack<(u32, f64)>,
+        prune: &mut impl FnMut() -> f64,
+        leaf: &mut impl FnMut(usize),
+    ) {
+        let node = &self.nodes[w as usize];
+        let lanes = usize::from(node.lanes);
+        // Unused children sort last and are skipped by their lane number.
+        let mut by_distance = [(f64::INFINITY, WIDTH); WIDTH];
+        for (i, slot) in by_distance[..lanes].iter_mut().enumerate() {
+            *slot = (node.lane_distance2(i, p), i);
+        }
+        // Nearest first, by a fixed network of five exchanges (a library sort of four
+        // was 14% of `qem measure`'s instructions); equal distances keep their lane
+        // order, so the walk is the same on every run. (Only the walk's speed depends
+        // on the order: every child within the bound is visited.)
+        for (x, y) in [(0, 1), (2, 3), (0, 2), (1, 3), (1, 2)] {
+            if by_distance[y].0 < by_distance[x].0 {
+                by_distance.swap(x, y);
+            }
+        }
+        for &(d2, i) in by_distance.iter().filter(|x| x.1 < WIDTH) {
+            let count = usize::from(node.leaf_count[i]);
+            if count == 0 || d2 > prune() {
+                continue;
+            }
+            let start = node.child[i] as usize;
+            for t in start..start + count {
+                leaf(t);
+            }
+        }
+        for &(d2, i) in by_distance.iter().rev().filter(|x| x.1 < WIDTH) {
+            if node.leaf_count[i] == 0 && d2 <= prune() {
+                stack.push((node.child[i], d2));
+            }
+        }
+    }
+
+    /// The exact distance from `p` to the nearest triangle, or `None` when there are no
+    /// triangles.
+    pub fn distance(&self, p: [f64; 3]) -> Option<f64> {
+        if self.corners.is_empty() {
+            return None;
+        }
+        let best = std::cell::Cell::new(f64::INFINITY);
+        let mut prune = || best.get() * PRUNE_FACTOR + self.slack2;
+        let mut leaf = |t: usize| {
+            let [a, b, c] = self.corners[t];
+            best.set(best.get().min(triangle_distance2(p, a, b, c)));
+        };
+        let mut stack = NodeStack::with((0u32, 0.0f64));
+        while let Some((w, d2)) = stack.pop() {
+            if d2 > prune() {
+                continue;
+            }
+            self.visit_nearest_first(w, p, &mut stack, &mut prune, &mut leaf);
+        }
+        Some(best.get().sqrt())
+    }
+
+    /// The triangles nearest to `p`: of the triangles whose distance to `p` is at most
+    /// `factor` times the distance of the nearest one plus `margin` (both distances, not
+    /// squares), the `max_count` nearest (by squared distance, then by index), as indices
+    /// for [`corners`](Self::corners) in ascending index order. `out` is cleared first;
+    /// it is empty when there are no triangles (or `max_count` is 0). Returns the
+    /// nearest triangle (the lowest index among those at the least squared distance),
+    /// `None` when there are no triangles.
+    ///
+    /// Why several: a point equally near two triangles (on their shared edge, say) has
+    /// no single nearest one, and a caller asking "which way does the surface face here"
+    /// must hear from all of them. Why a count: above a finely cut region the ball can
+    /// hold hundreds of triangles, and the count keeps the search's cost bounded (the
+    /// pruning radius shrinks to the `max_count`-th distance). `factor` below 1 counts
+    /// as 1, and a negative (or NaN) `margin` as 0.
+    pub fn nearest_triangles(
+        &self,
+        p: [f64; 3],
+        factor: f64,
+        margin: f64,
+        max_count: usize,
+        out: &mut Vec<u32>,
+    ) -> Option<u32> {
+        self.nearest_triangles_within(p, f64::INFINITY, factor, margin, max_count, out)
+    }
+
+    /// [`nearest_triangles`](Self::nearest_triangles) for a caller that already
+    /// knows a triangle at squared distance `known2` from `p` (the distance of some
+    /// triangle of this index, as [`distance_squared_to`](Self::distance_squared_to)
+    /// gives it; `f64::INFINITY` when none is known). The answer is the same; the
+    /// search prunes by that distance from the start instead of from its first leaf.
+    pub fn nearest_triangles_within(
+        &self,
+        p: [f64; 3],
+        known2: f64,
+        factor: f64,
+        margin: f64,
+        max_count: usize,
+        out: &mut Vec<u32>,
+    ) -> Option<u32> {
+        out.clear();
+        if self.corners.is_empty() {
+            return None;
+        }
+        let factor = factor.max(1.0);
+        // A negative margin would make the bound smaller than the nearest distance
+        // itself (and the answer empty); NaN counts as 0 too.
+        let margin = margin.max(0.0);
+        // The bound a triangle must meet, from the best squared distance so far.
+        let bound = |best2: f64| {
+            let d = best2.sqrt() * factor + margin;
+            d * d * PRUNE_FACTOR + self.slack2
+        };
+        // Why starting from `known2` changes nothing: it is a true squared distance, so
+        // `best2` never drops below the nearest triangle's squared distance, and every
+        // pruning bound stays at or above it; the nearest triangle's node is never
+        // skipped, and `best2` ends at its distance from either start.
+        let best2 = std::cell::Cell::new(if known2 >= 0.0 { known2 } else { f64::INFINITY });
+        // The nearest found so far, sorted by (squared distance, index), at most
+        // `max_count` long (and at least 1, to know the nearest).
+        let keep = max_count.max(1);
+        let candidates: std::cell::RefCell<smallvec::SmallVec<[(f64, u32); 16]>> =
+            std::cell::RefCell::new(smallvec::SmallVec::new());
+        let mut prune = || {
+            let b = bound(best2.get());
+            let candidates = candidates.borrow();
+            if candidates.len() == keep {
+                b.min(candidates[keep - 1].0 * PRUNE_FACTOR + self.slack2)
+            } else {
+                b
+            }
+        };
+        let mut leaf = |i: usize| {
+            let [a, b, c] = self.corners[i];
+            let d2 = triangle_distance2(p, a, b, c);
+            best2.set(best2.get().min(d2));
+            if d2 > bound(best2.get()) {
+                return;
+            }
+            let entry = (d2, i as u32);
+            let mut candidates = candidates.borrow_mut();
+            let at =
+                candidates.partition_point(|x| x.0.total_cmp(&d2).then(x.1.cmp(&entry.1)).is_lt());
+            if at < keep {
+                candidates.insert(at, entry);
+                candidates.truncate(keep);
+            }
+        };
+        let mut stack = NodeStack::with((0u32, 0.0f64));
+        while let Some((w, d2)) = stack.pop() {
+            if d2 > prune() {
+                continue;
+            }
+            self.visit_nearest_first(w, p, &mut stack, &mut prune, &mut leaf);
+        }
+        let candidates = candidates.into_inner();
+        let best2 = best2.get();
+        // Compared as distances, not squares: squaring the limit back can round it
+        // below `best2` itself and drop the nearest triangle.
+        let limit = best2.sqrt() * factor + margin;
+        out.extend(
+            candidates
+                .iter()
+                .take(max_count)
+                .filter(|&&(d2, _)| d2.sqrt() <= limit)
+                .map(|&(_, i)| i),
+        );
+        out.sort_unstable();
+        candidates.first().map(|&(_, i)| i)
+    }
+
+    /// The squared distance from `p` to triangle `i` (an index for
+    /// [`corners`](Self::corners)); `None` when `i` is out of range.
+    pub fn distance_squared_to(&self, p: [f64; 3], i: u32) -> Option<f64> {
+        let [a, b, c] = self.corners.get(i as usize)?;
+        Some(triangle_distance2(p, *a, *b, *c))
+    }
+
+    /// Number of indexed triangles (those of the mesh with valid indices); indices for
+    /// [`corners`](Self::corners) run below it.
+    pub fn triangle_count(&self) -> usize {
+        self.corners.len()
+    }
+
+    /// The corners of triangle `i` (an index from
+    /// [`nearest_triangles`](Self::nearest_triangles)), in their input order.
+    pub fn corners(&self, i: u32) -> [[f64; 3]; 3] {
+        self.corners[i as usize]
+    }
+}
+
+/// The binary tree over `corners` (reordered in place into leaf order), node 0 the root,
+/// children after their parent; and where each triangle went (`slots[i]` is the new
+/// index of the triangle that was at `i`).
+fn build_binary(corners: &mut [[P3; 3]]) -> (Vec<BinaryNode>, Vec<u32>) {
+    // Kept for the build only (24 bytes per triangle): recomputing them inside the
+    // median selection's comparisons made the dragon's index build about 0.3 s
+    // slower, and the build is on the critical path of the setup.
+    let centroid = |c: &[P3; 3]| -> P3 {
+        [
+            (c[0][0] + c[1][0] + c[2][0]) / 3.0,
+            (c[0][1] + c[1][1] + c[2][1]) / 3.0,
+            (c[0][2] + c[1][2] + c[2][2]) / 3.0,
+        ]
+    };
+    let centroids: Vec<P3> = corners.iter().map(centroid).collect();
+    let mut order: Vec<u32> = (0..corners.len() as u32).collect();
+    let mut nodes = Vec::with_capacity(2 * corners.len() / LEAF_SIZE + 1);
+    let blank = BinaryNode {
+        bounds: Aabb::EMPTY,
+        first: 0,
+        count: 0,
+    };
+    nodes.push(blank);
+    // (node index, range in `order`); explicit stack instead of recursion.
+    let mut stack = vec![(0usize, 0usize, order.len())];
+    while let Some((node, start, end)) = stack.pop() {
+        let mut bounds = Aabb::EMPTY;
+        let mut centroid_box = Aabb::EMPTY;
+        for &t in &order[start..end] {
+            for corner in corners[t as usize] {
+                bounds.grow(corner);
+            }
+            centroid_box.grow(centroids[t as usize]);
+        }
+        nodes[node].bounds = bounds;
+        if end - start <= LEAF_SIZE {
+            nodes[node].first = start as u32;
+            nodes[node].count = (end - start) as u32;
+            continue;
+        }
+        let extent = sub(centroid_box.hi, centroid_box.lo);
+        let axis = if extent[0] >= extent[1] && extent[0] >= extent[2] {
+            0
+        } else if extent[1] >= extent[2] {
+            1
+        } else {
+            2
+        };
+        let mid = start + (end - start) / 2;
+        order[start..end].select_nth_unstable_by(mid - start, |&x, &y| {
+            centroids[x as usize][axis]
+                .total_cmp(&centroids[y as usize][axis])
+                .then(x.cmp(&y))
+        });
+        let left = nodes.len();
+        nodes.push(blank);
+        nodes.push(blank);
+        nodes[node].first = left as u32;
+        nodes[node].count = 0;
+        stack.push((left, start, mid));
+        stack.push((left + 1, mid, end));
+    }
+    let mut slots = vec![0u32; order.len()];
+    for (slot, &t) in order.iter().enumerate() {
+        slots[t as usize] = slot as u32;
+    }
+    drop(order);
+    drop(centroids);
+    // Leaf order in place: each triangle swapped straight to its slot, cycle by
+    // cycle (`destination` follows the triangles as they move).
+    let mut destination = slots.clone();
+    for i in 0..corners.len() {
+        while destination[i] as usize != i {
+            let d = destination[i] as usize;
+            corners.swap(i, d);
+            destination.swap(i, d);
+        }
+    }
+    (nodes, slots)
+}
+
+/// The wide tree of a binary tree over `corners` (in leaf order, not empty): each wide
+/// node stands for a binary inner node and takes its grandchildren as children (or a
+/// child itself, where that is a leaf); a root that is a leaf becomes one node with one
+/// child.
+fn widen(binary: &[BinaryNode], corners: &[[P3; 3]]) -> Vec<WideNode> {
+    let normal_boxes = unit_normal_boxes(binary, corners);
+    let children_of = |n: usize| -> ([usize; WIDTH], usize) {
+        let mut out = [0; WIDTH];
+        let node = &binary[n];
+        if node.count > 0 {
+            out[0] = n;
+            return (out, 1);
+        }
+        let mut len = 0;
+        for c in [node.first as usize, node.first as usize + 1] {
+            let child = &binary[c];
+            if child.count > 0 {
+                out[len] = c;
+                len += 1;
+            } else {
+                out[len] = child.first as usize;
+                out[len + 1] = child.first as usize + 1;
+                len += 2;
+            }
+        }
+        (out, len)
+    };
+    let mut nodes = vec![WideNode::EMPTY];
+    // (binary node, wide node standing for it)
+    let mut stack = vec![(0usize, 0usize)];
+    while let Some((n, w)) = stack.pop() {
+        let (children, len) = children_of(n);
+        let mut wide = WideNode::EMPTY;
+        wide.lanes = len as u8;
+        for (i, &c) in children[..len].iter().enumerate() {
+            let node = &binary[c];
+            let position = Box32::around(node.bounds.lo, node.bounds.hi);
+            wide.set_child(i, &position, &normal_boxes[c]);
+            if node.count > 0 {
+                wide.child[i] = node.first;
+                wide.leaf_count[i] = node.count as u8;
+            } else {
+                wide.child[i] = nodes.len() as u32;
+                stack.push((c, nodes.len()));
+                nodes.push(WideNode::EMPTY);
+            }
+        }
+        nodes[w] = wide;
+    }
+    nodes
+}
+
+/// The box of the unit normals under each binary node, rounded outward to `f32`. A
+/// triangle whose normal's length under- or overflows (or is NaN) counts as facing
+/// every way; a zero-area one has no direction and no say.
+fn unit_normal_boxes(binary: &[BinaryNode], corners: &[[P3; 3]]) -> Vec<Box32> {
+    let mut boxes = vec![Box32::EMPTY; binary.len()];
+    // Children always have higher indices than their parent (see `build_binary`), so a
+    // reverse sweep sees both children before the parent.
+    for n in (0..binary.len()).rev() {
+        let node = binary[n];
+        let mut bounds = Box32::EMPTY;
+        if node.count > 0 {
+            let start = node.first as usize;
+            for [a, b, c] in &corners[start..start + node.count as usize] {
+                let normal = cross(sub(*b, *a), sub(*c, *a));
+                let length = length(normal);
+                if length > 0.0 && length.is_finite() {
+                    let unit = normal.map(|x| x / length);
+                    bounds.grow(&Box32::around(unit, unit));
+                } else if normal != [0.0; 3] {
+                    bounds.grow(&Box32::around([-1.0; 3], [1.0; 3]));
+                }
+            }
+        } else {
+            for child in [node.first as usize, node.first as usize + 1] {
+                bounds.grow(&boxes[child]);
+            }
+        }
+        boxes[n] = bounds;
+    }
+    boxes
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Outward rounding never lands inside the value, and stays within one `f32` step.
+    #[test]
+    fn rounding_is_outward() {
+        for x in [
+            0.1,
+            -0.1,
+            1.0 / 3.0,
+            -2.0 / 3.0,
+            1e-40,
+            1e39,
+            -1e39,
+            0.0,
+            0.5,
+        ] {
+            let (lo, hi) = (f32_below(x), f32_above(x));
+            assert!(f64::from(lo) <= x && x <= f64::from(hi), "{x}");
+            // Within one step: the next value below `hi` is at or below `x`.
+            assert!(
+                f64::from(step_toward_negative(hi)) <= x,
+                "{x}: {lo} .. {hi}"
+            );
+            assert!(
+                f64::from(-step_toward_negative(-lo)) >= x,
+                "{x}: {lo} .. {hi}"
+            );
+        }
+        assert_eq!(f32_below(f64::INFINITY), f32::INFINITY);
+        assert_eq!(f32_above(f64::NEG_INFINITY), f32::NEG_INFINITY);
+        assert_eq!(f32_below(0.5), 0.5);
+        assert_eq!(f32_below(1e300), f32::MAX);
+        assert!(f32_below(-1e-300) < 0.0 && f32_above(1e-300) > 0.0);
+    }
+
+    /// Every triangle sits in exactly one leaf child, and every child's box holds its
+    /// triangles: the wide tree loses nothing of the binary one.
+    #[test]
+    fn the_wide_tree_covers_every_triangle_once() {
+        let mut corners = Vec::new();
+        for i in 0..97 {
+            let x = f64::from(i) * 0.37;
+            corners.push([[x, 0.0, 0.1 * x], [x + 1.0, 0.5, 0.0], [x, 1.0, -0.2 * x]]);
+        }
+        let (bvh, slots) = TriangleBvh::from_corners(corners.clone());
+        let mut seen = vec![0u32; corners.len()];
+        let mut stack = vec![(
+            0u32,
+            Box32::around([f64::NEG_INFINITY; 3], [f64::INFINITY; 3]),
+        )];
+        while let Some((w, parent)) = stack.pop() {
+            let node = &bvh.nodes[w as usize];
+            assert!((1..=WIDTH as u8).contains(&node.lanes));
+            for i in 0..usize::from(node.lanes) {
+                let lane = Box32 {
+                    lo: [0, 1, 2].map(|k| node.lo[k][i]),
+                    hi: [0, 1, 2].map(|k| node.hi[k][i]),
+                };
+                for k in 0..3 {
+                    assert!(parent.lo[k] <= lane.lo[k] && lane.hi[k] <= parent.hi[k]);
+                }
+                let count = usize::from(node.leaf_count[i]);
+                if count == 0 {
+                    stack.push((node.child[i], lane));
+                    continue;
+                }
+                let start = node.child[i] as usize;
+                for (seen, corners) in seen[start..start + count]
+                    .iter_mut()
+                    .zip(&bvh.corners[start..start + count])
+                {
+                    *seen += 1;
+                    for corner in corners {
+                        for (k, &x) in corner.iter().enumerate() {
+                            assert!(f64::from(lane.lo[k]) <= x && x <= f64::from(lane.hi[k]));
+                        }
+                    }
+                }
+            }
+        }
+        assert!(seen.iter().all(|&n| n == 1), "{seen:?}");
+        for (i, &slot) in slots.iter().enumerate() {
+            assert_eq!(bvh.corners(slot), corners[i]);
+        }
+    }
+}
