@@ -566,7 +566,6 @@ fn build_binary(corners: &mut [[P3; 3]]) -> (Vec<BinaryNode>, Vec<u32>) {
 /// child itself, where that is a leaf); a root that is a leaf becomes one node with one
 /// child.
 fn widen(binary: &[BinaryNode], corners: &[[P3; 3]]) -> Vec<WideNode> {
-    let normal_boxes = unit_normal_boxes(binary, corners);
     let children_of = |n: usize| -> ([usize; WIDTH], usize) {
         let mut out = [0; WIDTH];
         let node = &binary[n];
@@ -598,7 +597,7 @@ fn widen(binary: &[BinaryNode], corners: &[[P3; 3]]) -> Vec<WideNode> {
         for (i, &c) in children[..len].iter().enumerate() {
             let node = &binary[c];
             let position = Box32::around(node.bounds.lo, node.bounds.hi);
-            wide.set_child(i, &position, &normal_boxes[c]);
+            wide.set_child(i, &position, &Box32::EMPTY);
             if node.count > 0 {
                 wide.child[i] = node.first;
                 wide.leaf_count[i] = node.count as u8;
@@ -610,39 +609,47 @@ fn widen(binary: &[BinaryNode], corners: &[[P3; 3]]) -> Vec<WideNode> {
         }
         nodes[w] = wide;
     }
+    fill_normal_boxes(&mut nodes, corners);
     nodes
 }
 
-/// The box of the unit normals under each binary node, rounded outward to `f32`. A
+/// Sets the box of the unit normals under each child of each node, rounded outward to
+/// `f32`, bottom-up (a child node always comes after its parent, see [`widen`]). A
 /// triangle whose normal's length under- or overflows (or is NaN) counts as facing
-/// every way; a zero-area one has no direction and no say.
-fn unit_normal_boxes(binary: &[BinaryNode], corners: &[[P3; 3]]) -> Vec<Box32> {
-    let mut boxes = vec![Box32::EMPTY; binary.len()];
-    // Children always have higher indices than their parent (see `build_binary`), so a
-    // reverse sweep sees both children before the parent.
-    for n in (0..binary.len()).rev() {
-        let node = binary[n];
-        let mut bounds = Box32::EMPTY;
-        if node.count > 0 {
-            let start = node.first as usize;
-            for [a, b, c] in &corners[start..start + node.count as usize] {
-                let normal = cross(sub(*b, *a), sub(*c, *a));
-                let length = length(normal);
-                if length > 0.0 && length.is_finite() {
-                    let unit = normal.map(|x| x / length);
-                    bounds.grow(&Box32::around(unit, unit));
-                } else if normal != [0.0; 3] {
-                    bounds.grow(&Box32::around([-1.0; 3], [1.0; 3]));
+/// every way; a zero-area one has no direction and no say. (Built on the wide tree
+/// rather than the binary one: no box per binary node at the build's peak.)
+fn fill_normal_boxes(nodes: &mut [WideNode], corners: &[[P3; 3]]) {
+    for w in (0..nodes.len()).rev() {
+        for i in 0..usize::from(nodes[w].lanes) {
+            let mut bounds = Box32::EMPTY;
+            let count = usize::from(nodes[w].leaf_count[i]);
+            let first = nodes[w].child[i] as usize;
+            if count > 0 {
+                for [a, b, c] in &corners[first..first + count] {
+                    let normal = cross(sub(*b, *a), sub(*c, *a));
+                    let length = length(normal);
+                    if length > 0.0 && length.is_finite() {
+                        let unit = normal.map(|x| x / length);
+                        bounds.grow(&Box32::around(unit, unit));
+                    } else if normal != [0.0; 3] {
+                        bounds.grow(&Box32::around([-1.0; 3], [1.0; 3]));
+                    }
+                }
+            } else {
+                let child = &nodes[first];
+                for j in 0..usize::from(child.lanes) {
+                    bounds.grow(&Box32 {
+                        lo: [0, 1, 2].map(|k| child.normal_lo[k][j]),
+                        hi: [0, 1, 2].map(|k| child.normal_hi[k][j]),
+                    });
                 }
             }
-        } else {
-            for child in [node.first as usize, node.first as usize + 1] {
-                bounds.grow(&boxes[child]);
+            for k in 0..3 {
+                nodes[w].normal_lo[k][i] = bounds.lo[k];
+                nodes[w].normal_hi[k][i] = bounds.hi[k];
             }
         }
-        boxes[n] = bounds;
     }
-    boxes
 }
 
 #[cfg(test)]
