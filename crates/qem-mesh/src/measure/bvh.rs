@@ -496,7 +496,7 @@ fn build_binary(corners: &mut [[P3; 3]]) -> (Vec<BinaryNode>, Vec<u32>) {
     };
     let centroids: Vec<P3> = corners.iter().map(centroid).collect();
     let mut order: Vec<u32> = (0..corners.len() as u32).collect();
-    let mut nodes = Vec::with_capacity(2 * corners.len() / LEAF_SIZE + 1);
+    let mut nodes = Vec::with_capacity(binary_node_count(corners.len()));
     let blank = BinaryNode {
         bounds: Aabb::EMPTY,
         first: 0,
@@ -559,6 +559,26 @@ fn build_binary(corners: &mut [[P3; 3]]) -> (Vec<BinaryNode>, Vec<u32>) {
         }
     }
     (nodes, slots)
+}
+
+/// How many nodes [`build_binary`] makes for `n` triangles: one, plus those of the two
+/// halves when `n` is above a leaf's size. Why exactly: reserving by an estimate (n/2)
+/// made the vector grow by doubling during the build, to room for twice the nodes
+/// it needs. At each depth the halves have
+/// at most two distinct sizes, so remembering the sizes seen keeps this O(log n).
+fn binary_node_count(n: usize) -> usize {
+    fn count(n: usize, seen: &mut Vec<(usize, usize)>) -> usize {
+        if n <= LEAF_SIZE {
+            return 1;
+        }
+        if let Some(&(_, c)) = seen.iter().find(|(m, _)| *m == n) {
+            return c;
+        }
+        let c = 1 + count(n / 2, seen) + count(n - n / 2, seen);
+        seen.push((n, c));
+        c
+    }
+    count(n, &mut Vec::new())
 }
 
 /// The wide tree of a binary tree over `corners` (in leaf order, not empty): each wide
@@ -687,6 +707,21 @@ mod tests {
         assert_eq!(f32_below(0.5), 0.5);
         assert_eq!(f32_below(1e300), f32::MAX);
         assert!(f32_below(-1e-300) < 0.0 && f32_above(1e-300) > 0.0);
+    }
+
+    /// The reserved node count is the count the build makes.
+    #[test]
+    fn the_node_count_is_exact() {
+        for n in [0usize, 1, 4, 5, 9, 17, 100, 1000, 4097] {
+            let mut corners: Vec<[P3; 3]> = (0..n)
+                .map(|i| {
+                    let x = i as f64;
+                    [[x, 0.0, 0.0], [x, 1.0, 0.0], [x, 0.0, 1.0]]
+                })
+                .collect();
+            let (nodes, _) = build_binary(&mut corners);
+            assert_eq!(nodes.len(), binary_node_count(n), "{n} triangles");
+        }
     }
 
     /// Every triangle sits in exactly one leaf child, and every child's box holds its
