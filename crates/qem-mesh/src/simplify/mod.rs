@@ -32,7 +32,7 @@ pub use options::{
 pub use report::{Simplified, SimplifyError, SimplifyReport, StopReason, Timings};
 
 use crate::clean::{clean, CleanOptions, Cleaned};
-use crate::store::{FaceKey, MeshStore};
+use crate::store::MeshStore;
 use crate::IndexedMesh;
 use engine::Engine;
 use qem_core::{DVec3, Frame};
@@ -155,14 +155,6 @@ pub fn simplify_levels(
     let frame = Frame::from_points(cleaned.mesh.positions.iter().map(|p| DVec3::from_array(*p)));
     let mut engine = Engine::new(store, frame, options);
     let clock = Instant::now();
-    // The store makes one face per cleaned triangle, in order, when none is refused;
-    // the orientation check's index seeds each face's search hint with its own triangle.
-    let faces_in_order: Vec<FaceKey> =
-        if options.orientation_check && engine.store.face_count() == cleaned.mesh.triangles.len() {
-            engine.store.faces().collect()
-        } else {
-            Vec::new()
-        };
     // The orientation check's index is independent of the quadrics and queue: built on
     // the other core meanwhile (deterministic either way).
     let ((), input_surface) = rayon::join(
@@ -170,16 +162,20 @@ pub fn simplify_levels(
         || {
             options
                 .orientation_check
-                .then(|| orientation::InputSurface::new(&cleaned.mesh, &frame, &faces_in_order))
+                .then(|| orientation::InputSurface::new(&cleaned.mesh, &frame))
         },
     );
-    drop(faces_in_order);
-    engine.input_surface = input_surface;
+    // The store makes one face per cleaned triangle, in order, when none is refused;
+    // each face's search hint starts as its own triangle.
+    engine.input_surface = input_surface.map(|(mut surface, slots)| {
+        surface.seed_hints(engine.store.faces(), engine.store.face_count(), &slots);
+        surface
+    });
     timings.setup = clock.elapsed();
     observer.cleaned(&cleaned.mesh, &frame);
     // The loop needs neither the cleaned mesh nor the keys of its vertices: gone before
-    // it starts, since the peak memory is reached in the loop (about 120 MB on a
-    // 4M-triangle mesh).
+    // it starts (about 120 MB on a 4M-triangle mesh), since it runs far longer than
+    // the setup and holds the most.
     drop(cleaned);
     drop(keys);
 

@@ -20,7 +20,7 @@ use crate::measure::TriangleBvh;
 use crate::store::FaceKey;
 use crate::IndexedMesh;
 use qem_core::{DVec3, Frame};
-use slotmap::SecondaryMap;
+use slotmap::Key;
 
 /// Input triangles up to this factor farther than the nearest one count as "nearest".
 /// Why not 1: a centroid over a shared edge or vertex is equally near to several
@@ -45,25 +45,35 @@ const NEAR_MARGIN: f64 = 1e-9;
 /// built from, so that it never looks at less than the full test would.
 const QUICK_RADIUS_FACTOR: f64 = 1.0 + 1e-9;
 
+/// A face without a hint in [`InputSurface`]'s table.
+const NO_HINT: u32 = u32::MAX;
+
+/// The slot index of a face key.
+fn slot_index(face: FaceKey) -> usize {
+    face.data().as_ffi() as u32 as usize
+}
+
 /// The input surface, indexed for nearest-triangle queries, in normalised units.
 #[derive(Debug)]
 pub(super) struct InputSurface {
     bvh: TriangleBvh,
     /// Reused query result.
     near: Vec<u32>,
-    /// Per face, an input triangle near it: at first the face's own input triangle,
-    /// then the nearest one at the face's last full test. Its distance to the face's
-    /// new centroid bounds the nearest distance from above, which is what the quick
-    /// test needs (and lets the full test prune from its first node). Any triangle
-    /// would give the same answers; a nearer one gives them sooner.
-    hints: SecondaryMap<FaceKey, u32>,
+    /// Per face (by the slot index of its key), an input triangle near it: at first
+    /// the face's own input triangle, then the nearest one at the face's last full
+    /// test; [`NO_HINT`] when there is none yet. Its distance to the face's new
+    /// centroid bounds the nearest distance from above, which is what the quick test
+    /// needs (and lets the full test prune from its first node). Any triangle would
+    /// give the same answers; a nearer one gives them sooner. (A plain vector: the
+    /// store never reuses a slot, and only live faces are asked about.)
+    hints: Vec<u32>,
 }
 
 impl InputSurface {
-    /// Indexes the cleaned mesh's triangles in the loop's frame. `faces[i]` is the
-    /// store's face made from the cleaned mesh's triangle `i` (or empty when the two do
-    /// not correspond one to one): each face's first hint is its own input triangle.
-    pub fn new(cleaned: &IndexedMesh, frame: &Frame, faces: &[FaceKey]) -> InputSurface {
+    /// Indexes the cleaned mesh's triangles in the loop's frame; also returns where
+    /// each went (`slots[i]`: the index's number for the cleaned mesh's triangle `i`),
+    /// for [`seed_hints`](Self::seed_hints).
+    pub fn new(cleaned: &IndexedMesh, frame: &Frame) -> (InputSurface, Vec<u32>) {
         // The corners in the loop's frame, gathered straight into the index (a
         // normalised copy of the mesh first would cost its size again at the peak).
         let to_loop = |i: u32| {
@@ -82,21 +92,53 @@ impl InputSurface {
                 .filter_map(|t| Some([to_loop(t[0])?, to_loop(t[1])?, to_loop(t[2])?])),
         );
         let (bvh, slots) = TriangleBvh::from_corners(corners);
-        // Why seed the hints: without one, a face's first test is a full nearest
-        // search (on the dragon at ratio 0.1, about 9 in 10 of the full searches).
-        // Any triangle would do for correctness (a hint only bounds the nearest
-        // distance from above); the face's own input triangle is the nearest one.
-        let mut hints = SecondaryMap::with_capacity(faces.len());
-        if faces.len() == slots.len() {
-            for (&face, &slot) in faces.iter().zip(&slots) {
-                hints.insert(face, slot);
-            }
-        }
-        InputSurface {
+        let surface = InputSurface {
             bvh,
             near: Vec::new(),
-            hints,
+            hints: Vec::new(),
+        };
+        (surface, slots)
+    }
+
+    /// Gives each face its own input triangle as its first hint: `faces` lists the
+    /// store's `face_count` faces in the order of the cleaned mesh's triangles they
+    /// were made from, `slots` is what [`new`](Self::new) returned. When the two do not correspond one
+    /// to one (the store refused some triangle), no face gets a hint yet.
+    ///
+    /// Why seed the hints: without one, a face's first test is a full nearest search
+    /// (on the dragon at ratio 0.1, about 9 in 10 of the full searches). Any triangle
+    /// would do for correctness (a hint only bounds the nearest distance from above);
+    /// the face's own input triangle is the nearest one.
+    pub fn seed_hints(
+        &mut self,
+        faces: impl Iterator<Item = FaceKey>,
+        face_count: usize,
+        slots: &[u32],
+    ) {
+        if face_count != slots.len() {
+            return;
         }
+        for (face, &slot) in faces.zip(slots) {
+            self.set_hint(face, slot);
+        }
+    }
+
+    /// The hint of `face`, if it has one.
+    #[inline]
+    fn hint(&self, face: FaceKey) -> Option<u32> {
+        self.hints
+            .get(slot_index(face))
+            .copied()
+            .filter(|&h| h != NO_HINT)
+    }
+
+    #[inline]
+    fn set_hint(&mut self, face: FaceKey, triangle: u32) {
+        let i = slot_index(face);
+        if self.hints.len() <= i {
+            self.hints.resize(i + 1, NO_HINT);
+        }
+        self.hints[i] = triangle;
     }
 
     /// Whether face `face`, moved to these corners (normalised units), faces the same
@@ -108,6 +150,7 @@ impl InputSurface {
     /// within `NEAR_FACTOR·u + NEAR_MARGIN`; if no triangle in that ball faces away
     /// (a search that skips whole subtrees whose normals all agree), the answer is yes.
     /// Otherwise the full test: find the nearest triangles and ask each of them.
+    #[inline]
     pub fn agrees(
         &mut self,
         face: FaceKey,
@@ -116,7 +159,7 @@ impl InputSurface {
     ) -> bool {
         let normal = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
         let centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
-        let hint = self.hints.get(face).copied().or(*neighbour_hint);
+        let hint = self.hint(face).or(*neighbour_hint);
         *neighbour_hint = hint;
         let known2 = hint.and_then(|h| self.bvh.distance_squared_to(centroid.to_array(), h));
         if let Some(u2) = known2 {
@@ -139,7 +182,7 @@ impl InputSurface {
             &mut self.near,
         );
         if let Some(t) = nearest {
-            self.hints.insert(face, t);
+            self.set_hint(face, t);
             *neighbour_hint = Some(t);
         }
         // A zero-area input triangle (cleaning drops exact ones) has no say.
