@@ -183,9 +183,9 @@ impl Engine {
                 if let Some(min_cos) = self.settings.min_normal_cos {
                     // The second test stops a face from turning away from the input face
                     // it descends from in several small steps.
-                    let input_normal = self.original_normals.get(f).copied();
+                    let input_normal = *self.original_normals.get(f);
                     if turned_past(old_normal, new_normal, new_squared, min_cos)
-                        || input_normal.is_some_and(|n| n.dot(new_normal) < 0.0)
+                        || input_normal.dot(new_normal) < 0.0
                     {
                         verdict = Err(Rejection::Flip);
                         break 'vertices;

@@ -9,7 +9,7 @@ use super::report::{SimplifyError, StopReason};
 use crate::clean::min_double_area;
 use crate::pairs::grid::{virtual_pairs, GridOptions};
 use crate::queue::PairQueue;
-use crate::store::{EdgeKey, FaceKey, MeshStore, VertexKey};
+use crate::store::{EdgeKey, FaceKey, MeshStore, SlotVec, VertexKey};
 use crate::IndexedMesh;
 use qem_core::{
     endpoint_placement, optimal_placement, unit_normal_and_area, DVec3, Frame, Placement,
@@ -244,8 +244,9 @@ pub(super) struct Engine {
     /// Intersection quadrics, with [`QuadricMode::Exact`] only.
     exact: Option<ExactQuadrics>,
     /// The (unnormalised) normal of every input face, for the fold-over check and
-    /// [`Engine::flipped_faces`].
-    pub original_normals: SecondaryMap<FaceKey, DVec3>,
+    /// [`Engine::flipped_faces`]; zero for a face without one (a zero normal's dot
+    /// product is never negative, so it has no say).
+    pub original_normals: SlotVec<FaceKey, DVec3>,
     /// Virtual-pair partners (vertices within t that share no edge) of the vertices
     /// that have any; kept apart from [`VertexState`] since most vertices have none.
     partners: SecondaryMap<VertexKey, SmallVec<[VertexKey; 4]>>,
@@ -291,7 +292,7 @@ impl Engine {
             state: VertexStates::with_capacity(store.vertex_count()),
             queue: PairQueue::new(&store),
             exact: (options.quadrics == QuadricMode::Exact).then(|| ExactQuadrics::new(&store)),
-            original_normals: SecondaryMap::with_capacity(store.face_count()),
+            original_normals: SlotVec::for_keys(store.faces(), DVec3::ZERO),
             partners: SecondaryMap::new(),
             store,
             frame,
@@ -346,7 +347,7 @@ impl Engine {
                 self.normalized_position(b),
                 self.normalized_position(c),
             );
-            self.original_normals.insert(f, (pb - pa).cross(pc - pa));
+            self.original_normals.set(f, (pb - pa).cross(pc - pa));
             let plane = match area_offset {
                 Some(extra) => WeightedPlane::from_triangle_area_plus(pa, pb, pc, extra),
                 None => WeightedPlane::from_triangle_unweighted(pa, pb, pc),
@@ -808,9 +809,7 @@ impl Engine {
                     .face_vertices(f)
                     .map(|v| self.normalized_position(v));
                 let now = (p1 - p0).cross(p2 - p0);
-                self.original_normals
-                    .get(f)
-                    .is_some_and(|was| now.dot(*was) < 0.0)
+                now.dot(*self.original_normals.get(f)) < 0.0
             })
             .count()
     }

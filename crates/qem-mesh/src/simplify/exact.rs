@@ -31,35 +31,29 @@
 //! `a x y` sums into it (a 4-vertex intersection is always empty). Edges and faces away
 //! from `a` and `b` keep their quadrics: their groups did not change.
 
-use crate::store::{ContractError, ContractLog, EdgeKey, FaceKey, MeshStore, VertexKey};
+use crate::store::{ContractError, ContractLog, EdgeKey, FaceKey, MeshStore, SlotVec, VertexKey};
 use qem_core::{Quadric, WeightedPlane};
-use slotmap::Key;
 use std::collections::HashMap;
-
-/// The slot index of a store key. Why slot-indexed vectors rather than `SecondaryMap`s:
-/// the store never reuses a slot, so the versions a `SecondaryMap` keeps (8 bytes an
-/// entry, with padding) would tell nothing apart; on a 4M-triangle mesh they were 80 MB.
-fn slot<K: Key>(key: K) -> usize {
-    key.data().as_ffi() as u32 as usize
-}
 
 /// Intersection quadrics on edges and faces, and the buffers of one contraction.
 ///
-/// Entries are by the key's slot index and are read only for live keys (the loop never
-/// asks about a removed edge or face); a removed entry is set to zero, so a stale read
-/// would see no plane rather than an old one.
-#[derive(Debug, Default)]
+/// Kept in [`SlotVec`]s rather than `SecondaryMap`s: the versions a `SecondaryMap`
+/// keeps (8 bytes an entry, with padding) were 80 MB on a 4M-triangle mesh. Entries are
+/// read only for live keys (the loop never asks about a removed edge or face), and a
+/// removed element's entry is cleared, so a stale read would see no plane rather than
+/// an old one.
+#[derive(Debug)]
 pub(super) struct ExactQuadrics {
     /// `Q_ab` for every live edge `a–b`.
-    edges: Vec<Quadric>,
+    edges: SlotVec<EdgeKey, Quadric>,
     /// The plane of the input face on each face: its `Q_abc` while no other face has
     /// merged into it. Why planes (40 bytes) rather than quadrics (80): a face's quadric
     /// is read only when it collapses or merges, about twice per contraction, and was
     /// 350 MB on a 4M-triangle mesh.
-    face_planes: Vec<WeightedPlane>,
+    face_planes: SlotVec<FaceKey, WeightedPlane>,
     /// `Q_abc` of the faces that duplicates merged into (no longer one plane), by
     /// slot. Rare: only duplicate faces merge. Only looked up, never iterated.
-    merged_faces: HashMap<usize, Quadric>,
+    merged_faces: HashMap<FaceKey, Quadric>,
     /// What the store merged, reused across contractions.
     log: ContractLog,
     /// The third vertex and quadric of each face on the contracted edge, taken before
@@ -70,11 +64,9 @@ pub(super) struct ExactQuadrics {
 impl ExactQuadrics {
     /// Zero quadrics on every edge of `store`, room for every face.
     pub fn new(store: &MeshStore) -> Self {
-        let edge_slots = store.edges().map(|e| slot(e) + 1).max().unwrap_or(0);
-        let face_slots = store.faces().map(|f| slot(f) + 1).max().unwrap_or(0);
         ExactQuadrics {
-            edges: vec![Quadric::ZERO; edge_slots],
-            face_planes: vec![WeightedPlane::NONE; face_slots],
+            edges: SlotVec::for_keys(store.edges(), Quadric::ZERO),
+            face_planes: SlotVec::for_keys(store.faces(), WeightedPlane::NONE),
             merged_faces: HashMap::new(),
             log: ContractLog::default(),
             collapsed: Vec::new(),
@@ -85,9 +77,7 @@ impl ExactQuadrics {
     /// quadric (`plane.quadric()`, which the caller has already computed).
     pub fn add_face(&mut self, f: FaceKey, edges: [EdgeKey; 3], plane: WeightedPlane, q: Quadric) {
         debug_assert_eq!(plane.quadric(), q);
-        if let Some(entry) = self.face_planes.get_mut(slot(f)) {
-            *entry = plane;
-        }
+        self.face_planes.set(f, plane);
         for e in edges {
             self.add_edge_plane(e, q);
         }
@@ -95,7 +85,7 @@ impl ExactQuadrics {
 
     /// Records a plane supported by the two ends of edge `e` (a border plane).
     pub fn add_edge_plane(&mut self, e: EdgeKey, q: Quadric) {
-        if let Some(sum) = self.edges.get_mut(slot(e)) {
+        if let Some(sum) = self.edges.get_mut(e) {
             *sum += q;
         }
     }
@@ -103,8 +93,7 @@ impl ExactQuadrics {
     /// `Q_ab` of edge `e` (live), or zero for a pair without edge.
     #[inline]
     pub fn edge(&self, e: Option<EdgeKey>) -> Quadric {
-        e.and_then(|e| self.edges.get(slot(e)).copied())
-            .unwrap_or(Quadric::ZERO)
+        e.map_or(Quadric::ZERO, |e| *self.edges.get(e))
     }
 
     /// Contracts `b` into `a` in `store` and updates the intersection quadrics. The
@@ -136,13 +125,11 @@ impl ExactQuadrics {
         for &(removed, kept) in &log.faces_merged {
             let q = face_quadric(face_planes, merged_faces, removed);
             let sum = face_quadric(face_planes, merged_faces, kept) + q;
-            merged_faces.insert(slot(kept), sum);
+            merged_faces.insert(kept, sum);
             forget_face(face_planes, merged_faces, removed);
         }
         for &(removed, kept) in &log.edges_merged {
-            let q_bx = edges
-                .get_mut(slot(removed))
-                .map_or(Quadric::ZERO, std::mem::take);
+            let q_bx = edges.take(removed);
             let Some(x) = store.other_vertex(kept, a) else {
                 continue;
             };
@@ -152,7 +139,7 @@ impl ExactQuadrics {
                 .iter()
                 .find(|(y, _)| *y == x)
                 .map_or(Quadric::ZERO, |(_, q)| *q);
-            if let Some(sum) = edges.get_mut(slot(kept)) {
+            if let Some(sum) = edges.get_mut(kept) {
                 *sum += q_bx - q_abx;
             }
         }
@@ -160,9 +147,7 @@ impl ExactQuadrics {
             forget_face(face_planes, merged_faces, f);
         }
         if let Some(e) = log.edge_collapsed {
-            if let Some(q) = edges.get_mut(slot(e)) {
-                *q = Quadric::ZERO;
-            }
+            edges.take(e);
         }
         Ok(())
     }
@@ -171,28 +156,22 @@ impl ExactQuadrics {
 /// `Q_abc` of live face `f`: the sum kept for it if faces merged into it, else its
 /// input face's plane.
 fn face_quadric(
-    face_planes: &[WeightedPlane],
-    merged_faces: &HashMap<usize, Quadric>,
+    face_planes: &SlotVec<FaceKey, WeightedPlane>,
+    merged_faces: &HashMap<FaceKey, Quadric>,
     f: FaceKey,
 ) -> Quadric {
-    let i = slot(f);
-    match merged_faces.get(&i) {
+    match merged_faces.get(&f) {
         Some(&q) => q,
-        None => face_planes
-            .get(i)
-            .map_or(Quadric::ZERO, WeightedPlane::quadric),
+        None => face_planes.get(f).quadric(),
     }
 }
 
 /// Clears the entries of removed face `f`.
 fn forget_face(
-    face_planes: &mut [WeightedPlane],
-    merged_faces: &mut HashMap<usize, Quadric>,
+    face_planes: &mut SlotVec<FaceKey, WeightedPlane>,
+    merged_faces: &mut HashMap<FaceKey, Quadric>,
     f: FaceKey,
 ) {
-    let i = slot(f);
-    if let Some(plane) = face_planes.get_mut(i) {
-        *plane = WeightedPlane::NONE;
-    }
-    merged_faces.remove(&i);
+    face_planes.take(f);
+    merged_faces.remove(&f);
 }

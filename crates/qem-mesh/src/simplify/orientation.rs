@@ -17,10 +17,9 @@
 //! any of them faces away (normal dot product ≤ 0).
 
 use crate::measure::TriangleBvh;
-use crate::store::FaceKey;
+use crate::store::{FaceKey, SlotVec};
 use crate::IndexedMesh;
 use qem_core::{DVec3, Frame};
-use slotmap::Key;
 
 /// Input triangles up to this factor farther than the nearest one count as "nearest".
 /// Why not 1: a centroid over a shared edge or vertex is equally near to several
@@ -48,25 +47,19 @@ const QUICK_RADIUS_FACTOR: f64 = 1.0 + 1e-9;
 /// A face without a hint in [`InputSurface`]'s table.
 const NO_HINT: u32 = u32::MAX;
 
-/// The slot index of a face key.
-fn slot_index(face: FaceKey) -> usize {
-    face.data().as_ffi() as u32 as usize
-}
-
 /// The input surface, indexed for nearest-triangle queries, in normalised units.
 #[derive(Debug)]
 pub(super) struct InputSurface {
     bvh: TriangleBvh,
     /// Reused query result.
     near: Vec<u32>,
-    /// Per face (by the slot index of its key), an input triangle near it: at first
-    /// the face's own input triangle, then the nearest one at the face's last full
-    /// test; [`NO_HINT`] when there is none yet. Its distance to the face's new
-    /// centroid bounds the nearest distance from above, which is what the quick test
-    /// needs (and lets the full test prune from its first node). Any triangle would
-    /// give the same answers; a nearer one gives them sooner. (A plain vector: the
-    /// store never reuses a slot, and only live faces are asked about.)
-    hints: Vec<u32>,
+    /// Per face, an input triangle near it: at first the face's own input triangle,
+    /// then the nearest one at the face's last full test; [`NO_HINT`] when there is
+    /// none yet. Its distance to the face's new centroid bounds the nearest distance
+    /// from above, which is what the quick test needs (and lets the full test prune
+    /// from its first node). Any triangle would give the same answers; a nearer one
+    /// gives them sooner.
+    hints: SlotVec<FaceKey, u32>,
 }
 
 impl InputSurface {
@@ -95,7 +88,7 @@ impl InputSurface {
         let surface = InputSurface {
             bvh,
             near: Vec::new(),
-            hints: Vec::new(),
+            hints: SlotVec::for_keys(std::iter::empty(), NO_HINT),
         };
         (surface, slots)
     }
@@ -111,34 +104,23 @@ impl InputSurface {
     /// the face's own input triangle is the nearest one.
     pub fn seed_hints(
         &mut self,
-        faces: impl Iterator<Item = FaceKey>,
+        faces: impl Iterator<Item = FaceKey> + Clone,
         face_count: usize,
         slots: &[u32],
     ) {
         if face_count != slots.len() {
             return;
         }
+        self.hints = SlotVec::for_keys(faces.clone(), NO_HINT);
         for (face, &slot) in faces.zip(slots) {
-            self.set_hint(face, slot);
+            self.hints.set(face, slot);
         }
     }
 
     /// The hint of `face`, if it has one.
     #[inline]
     fn hint(&self, face: FaceKey) -> Option<u32> {
-        self.hints
-            .get(slot_index(face))
-            .copied()
-            .filter(|&h| h != NO_HINT)
-    }
-
-    #[inline]
-    fn set_hint(&mut self, face: FaceKey, triangle: u32) {
-        let i = slot_index(face);
-        if self.hints.len() <= i {
-            self.hints.resize(i + 1, NO_HINT);
-        }
-        self.hints[i] = triangle;
+        Some(*self.hints.get(face)).filter(|&h| h != NO_HINT)
     }
 
     /// Whether face `face`, moved to these corners (normalised units), faces the same
@@ -182,7 +164,7 @@ impl InputSurface {
             &mut self.near,
         );
         if let Some(t) = nearest {
-            self.set_hint(face, t);
+            self.hints.set(face, t);
             *neighbour_hint = Some(t);
         }
         // A zero-area input triangle (cleaning drops exact ones) has no say.

@@ -90,7 +90,7 @@ impl MeshStore {
     }
 
     /// Keys of all live faces, in slotmap order (deterministic).
-    pub fn faces(&self) -> impl Iterator<Item = FaceKey> + '_ {
+    pub fn faces(&self) -> impl Iterator<Item = FaceKey> + Clone + '_ {
         self.faces.keys()
     }
 
