@@ -1,12 +1,12 @@
 //! [`TriangleBvh`]: a bounding-volume hierarchy over the triangles of one mesh, for
 //! exact nearest-triangle queries (Metro sampling, the orientation check).
 //!
-//! Built as a binary tree (median splits), then stored as a 4-wide tree: each node
-//! holds its (up to) four children's boxes side by side in `f32`, by axis, two binary
-//! levels at once. Why: a walk reads one node (four cache lines) where it read four
-//! binary nodes in as many places, tests four boxes with the same instructions, and a
-//! node costs about 54 bytes per child instead of 56 for the binary node plus 48 for
-//! its normal box. The binary tree is dropped once the wide one is built.
+//! Split as a binary tree would be (at median centroids), but stored as a 4-wide tree:
+//! each node holds its (up to) four children's boxes side by side in `f32`, by axis,
+//! two binary levels at once. Why: a walk reads one node (four cache lines) where it
+//! read four binary nodes in as many places, tests four boxes with the same
+//! instructions, and a node costs about 54 bytes per child instead of 56 for a binary
+//! node plus 48 for its normal box.
 //!
 //! Why `f32` boxes change no answer: every box is rounded outward, so the distance to
 //! it is never more than the distance to the exact box, and a subtree is skipped only
@@ -48,16 +48,6 @@ impl Aabb {
             self.hi[k] = self.hi[k].max(x);
         }
     }
-}
-
-/// A node of the binary tree, for the build.
-#[derive(Clone, Copy, Debug)]
-struct BinaryNode {
-    bounds: Aabb,
-    /// Leaf: start in `order`; inner: index of the first child (the second follows it).
-    first: u32,
-    /// Leaf: number of triangles (> 0); inner: 0.
-    count: u32,
 }
 
 /// `x` rounded to an `f32` at or below it (−∞ and +∞ stay).
@@ -256,8 +246,7 @@ impl TriangleBvh {
     /// rest are left out.
     pub fn from_corners(mut corners: Vec<[P3; 3]>) -> (TriangleBvh, Vec<u32>) {
         corners.truncate(u32::MAX as usize);
-        let (binary, slots) = build_binary(&mut corners);
-        let root = binary[0].bounds;
+        let (nodes, slots, root) = build(&mut corners);
         let scale = (0..3)
             .map(|k| root.lo[k].abs().max(root.hi[k].abs()))
             .fold(0.0, f64::max);
@@ -265,11 +254,6 @@ impl TriangleBvh {
             1e-12 * scale
         } else {
             0.0
-        };
-        let nodes = if corners.is_empty() {
-            Vec::new()
-        } else {
-            widen(&binary, &corners)
         };
         (
             TriangleBvh {
@@ -480,10 +464,17 @@ impl TriangleBvh {
     }
 }
 
-/// The binary tree over `corners` (reordered in place into leaf order), node 0 the root,
-/// children after their parent; and where each triangle went (`slots[i]` is the new
-/// index of the triangle that was at `i`).
-fn build_binary(corners: &mut [[P3; 3]]) -> (Vec<BinaryNode>, Vec<u32>) {
+/// The tree over `corners` (reordered in place into leaf order), node 0 the root,
+/// every node after its parent; where each triangle went (`slots[i]` is the new index
+/// of the triangle that was at `i`); and the box of all the corners.
+///
+/// The splits are those of a binary tree: a range of more than [`LEAF_SIZE`] triangles
+/// is split at its median centroid along the longest axis of its centroids' box (ties
+/// broken by triangle index, so the tree is deterministic). A node stands for one such
+/// split and its two halves' splits: its children are the four quarter ranges (or a
+/// half, where the half is a leaf). Built straight into wide nodes, so the build never
+/// holds a binary node per range (56 bytes each, about 134 MB on the 4M sphere).
+fn build(corners: &mut [[P3; 3]]) -> (Vec<WideNode>, Vec<u32>, Aabb) {
     // Kept for the build only (24 bytes per triangle): recomputing them inside the
     // median selection's comparisons made the dragon's index build about 0.3 s
     // slower, and the build is on the critical path of the setup.
@@ -496,30 +487,21 @@ fn build_binary(corners: &mut [[P3; 3]]) -> (Vec<BinaryNode>, Vec<u32>) {
     };
     let centroids: Vec<P3> = corners.iter().map(centroid).collect();
     let mut order: Vec<u32> = (0..corners.len() as u32).collect();
-    let mut nodes = Vec::with_capacity(binary_node_count(corners.len()));
-    let blank = BinaryNode {
-        bounds: Aabb::EMPTY,
-        first: 0,
-        count: 0,
-    };
-    nodes.push(blank);
-    // (node index, range in `order`); explicit stack instead of recursion.
-    let mut stack = vec![(0usize, 0usize, order.len())];
-    while let Some((node, start, end)) = stack.pop() {
+    // The box of the corners and the box of the centroids of `order[start..end]`.
+    let boxes_of = |order: &[u32]| {
         let mut bounds = Aabb::EMPTY;
         let mut centroid_box = Aabb::EMPTY;
-        for &t in &order[start..end] {
+        for &t in order {
             for corner in corners[t as usize] {
                 bounds.grow(corner);
             }
             centroid_box.grow(centroids[t as usize]);
         }
-        nodes[node].bounds = bounds;
-        if end - start <= LEAF_SIZE {
-            nodes[node].first = start as u32;
-            nodes[node].count = (end - start) as u32;
-            continue;
-        }
+        (bounds, centroid_box)
+    };
+    // Splits `order[start..end]` at its median along the longest axis of its
+    // centroids' box; the middle index.
+    let split = |order: &mut [u32], start: usize, end: usize, centroid_box: &Aabb| {
         let extent = sub(centroid_box.hi, centroid_box.lo);
         let axis = if extent[0] >= extent[1] && extent[0] >= extent[2] {
             0
@@ -534,13 +516,56 @@ fn build_binary(corners: &mut [[P3; 3]]) -> (Vec<BinaryNode>, Vec<u32>) {
                 .total_cmp(&centroids[y as usize][axis])
                 .then(x.cmp(&y))
         });
-        let left = nodes.len();
-        nodes.push(blank);
-        nodes.push(blank);
-        nodes[node].first = left as u32;
-        nodes[node].count = 0;
-        stack.push((left, start, mid));
-        stack.push((left + 1, mid, end));
+        mid
+    };
+    let (root_bounds, root_centroids) = boxes_of(&order);
+    let mut nodes = Vec::with_capacity(wide_node_count(corners.len()));
+    if !corners.is_empty() {
+        nodes.push(WideNode::EMPTY);
+    }
+    // (wide node, its range in `order`, the range's centroid box)
+    let mut stack = vec![(0usize, 0usize, order.len(), root_centroids)];
+    while let Some((w, start, end, centroid_box)) = stack.pop() {
+        if nodes.is_empty() {
+            break;
+        }
+        // The children's ranges: the quarters of a range, a half where the half is a
+        // leaf; a root that is itself a leaf is its node's only child.
+        let mut ranges = [(0usize, 0usize); WIDTH];
+        let mut lanes = 0;
+        if end - start <= LEAF_SIZE {
+            ranges[0] = (start, end);
+            lanes = 1;
+        } else {
+            let mid = split(&mut order, start, end, &centroid_box);
+            for (s, e) in [(start, mid), (mid, end)] {
+                if e - s <= LEAF_SIZE {
+                    ranges[lanes] = (s, e);
+                    lanes += 1;
+                } else {
+                    let (_, half_centroids) = boxes_of(&order[s..e]);
+                    let m = split(&mut order, s, e, &half_centroids);
+                    ranges[lanes] = (s, m);
+                    ranges[lanes + 1] = (m, e);
+                    lanes += 2;
+                }
+            }
+        }
+        let mut wide = WideNode::EMPTY;
+        wide.lanes = lanes as u8;
+        for (i, &(s, e)) in ranges[..lanes].iter().enumerate() {
+            let (bounds, child_centroids) = boxes_of(&order[s..e]);
+            wide.set_child(i, &Box32::around(bounds.lo, bounds.hi), &Box32::EMPTY);
+            if e - s <= LEAF_SIZE {
+                wide.child[i] = s as u32;
+                wide.leaf_count[i] = (e - s) as u8;
+            } else {
+                wide.child[i] = nodes.len() as u32;
+                stack.push((nodes.len(), s, e, child_centroids));
+                nodes.push(WideNode::EMPTY);
+            }
+        }
+        nodes[w] = wide;
     }
     let mut slots = vec![0u32; order.len()];
     for (slot, &t) in order.iter().enumerate() {
@@ -558,86 +583,47 @@ fn build_binary(corners: &mut [[P3; 3]]) -> (Vec<BinaryNode>, Vec<u32>) {
             destination.swap(i, d);
         }
     }
-    (nodes, slots)
+    drop(destination);
+    fill_normal_boxes(&mut nodes, corners);
+    (nodes, slots, root_bounds)
 }
 
-/// How many nodes [`build_binary`] makes for `n` triangles: one, plus those of the two
-/// halves when `n` is above a leaf's size. Why exactly: reserving by an estimate (n/2)
-/// made the vector grow by doubling during the build, to room for twice the nodes
-/// it needs. At each depth the halves have
-/// at most two distinct sizes, so remembering the sizes seen keeps this O(log n).
-fn binary_node_count(n: usize) -> usize {
-    fn count(n: usize, seen: &mut Vec<(usize, usize)>) -> usize {
-        if n <= LEAF_SIZE {
-            return 1;
-        }
+/// How many nodes [`build`] makes for `n` triangles: one if there are any, plus those
+/// of each child range above a leaf's size. Why exactly: a vector grown by doubling
+/// holds up to twice the room it needs. At each depth the ranges have at most two
+/// distinct sizes, so remembering the sizes seen keeps this O(log n).
+fn wide_node_count(n: usize) -> usize {
+    fn below(n: usize, seen: &mut Vec<(usize, usize)>) -> usize {
+        // Nodes for a range of `n` triangles that has a node of its own.
         if let Some(&(_, c)) = seen.iter().find(|(m, _)| *m == n) {
             return c;
         }
-        let c = 1 + count(n / 2, seen) + count(n - n / 2, seen);
+        let mut c = 1;
+        if n > LEAF_SIZE {
+            for half in [n / 2, n - n / 2] {
+                if half > LEAF_SIZE {
+                    for quarter in [half / 2, half - half / 2] {
+                        if quarter > LEAF_SIZE {
+                            c += below(quarter, seen);
+                        }
+                    }
+                }
+            }
+        }
         seen.push((n, c));
         c
     }
-    count(n, &mut Vec::new())
-}
-
-/// The wide tree of a binary tree over `corners` (in leaf order, not empty): each wide
-/// node stands for a binary inner node and takes its grandchildren as children (or a
-/// child itself, where that is a leaf); a root that is a leaf becomes one node with one
-/// child.
-fn widen(binary: &[BinaryNode], corners: &[[P3; 3]]) -> Vec<WideNode> {
-    let children_of = |n: usize| -> ([usize; WIDTH], usize) {
-        let mut out = [0; WIDTH];
-        let node = &binary[n];
-        if node.count > 0 {
-            out[0] = n;
-            return (out, 1);
-        }
-        let mut len = 0;
-        for c in [node.first as usize, node.first as usize + 1] {
-            let child = &binary[c];
-            if child.count > 0 {
-                out[len] = c;
-                len += 1;
-            } else {
-                out[len] = child.first as usize;
-                out[len + 1] = child.first as usize + 1;
-                len += 2;
-            }
-        }
-        (out, len)
-    };
-    let mut nodes = vec![WideNode::EMPTY];
-    // (binary node, wide node standing for it)
-    let mut stack = vec![(0usize, 0usize)];
-    while let Some((n, w)) = stack.pop() {
-        let (children, len) = children_of(n);
-        let mut wide = WideNode::EMPTY;
-        wide.lanes = len as u8;
-        for (i, &c) in children[..len].iter().enumerate() {
-            let node = &binary[c];
-            let position = Box32::around(node.bounds.lo, node.bounds.hi);
-            wide.set_child(i, &position, &Box32::EMPTY);
-            if node.count > 0 {
-                wide.child[i] = node.first;
-                wide.leaf_count[i] = node.count as u8;
-            } else {
-                wide.child[i] = nodes.len() as u32;
-                stack.push((c, nodes.len()));
-                nodes.push(WideNode::EMPTY);
-            }
-        }
-        nodes[w] = wide;
+    if n == 0 {
+        0
+    } else {
+        below(n, &mut Vec::new())
     }
-    fill_normal_boxes(&mut nodes, corners);
-    nodes
 }
 
 /// Sets the box of the unit normals under each child of each node, rounded outward to
-/// `f32`, bottom-up (a child node always comes after its parent, see [`widen`]). A
+/// `f32`, bottom-up (a child node always comes after its parent, see [`build`]). A
 /// triangle whose normal's length under- or overflows (or is NaN) counts as facing
-/// every way; a zero-area one has no direction and no say. (Built on the wide tree
-/// rather than the binary one: no box per binary node at the build's peak.)
+/// every way; a zero-area one has no direction and no say.
 fn fill_normal_boxes(nodes: &mut [WideNode], corners: &[[P3; 3]]) {
     for w in (0..nodes.len()).rev() {
         for i in 0..usize::from(nodes[w].lanes) {
@@ -719,13 +705,13 @@ mod tests {
                     [[x, 0.0, 0.0], [x, 1.0, 0.0], [x, 0.0, 1.0]]
                 })
                 .collect();
-            let (nodes, _) = build_binary(&mut corners);
-            assert_eq!(nodes.len(), binary_node_count(n), "{n} triangles");
+            let (nodes, _, _) = build(&mut corners);
+            assert_eq!(nodes.len(), wide_node_count(n), "{n} triangles");
         }
     }
 
     /// Every triangle sits in exactly one leaf child, and every child's box holds its
-    /// triangles: the wide tree loses nothing of the binary one.
+    /// triangles.
     #[test]
     fn the_wide_tree_covers_every_triangle_once() {
         let mut corners = Vec::new();
