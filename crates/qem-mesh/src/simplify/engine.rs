@@ -53,6 +53,48 @@ fn ordered_pair(a: VertexKey, b: VertexKey) -> (VertexKey, VertexKey) {
     }
 }
 
+/// [`Engine::place`], from the parts of the engine it reads (so that the setup can
+/// cost every edge while it walks the store's edges).
+fn place(
+    state: &VertexStates,
+    exact: Option<&ExactQuadrics>,
+    placement: PlacementMode,
+    a: VertexKey,
+    b: VertexKey,
+    ab: Option<EdgeKey>,
+) -> (Placement, Quadric) {
+    let (sa, sb) = (&state[a], &state[b]);
+    let mut q = sa.quadric + sb.quadric;
+    if let Some(exact) = exact {
+        q -= exact.edge(ab);
+    }
+    let fixed = if sa.locked {
+        Some((a, PlacementRule::FirstEnd))
+    } else if sb.locked {
+        Some((b, PlacementRule::SecondEnd))
+    } else {
+        None
+    };
+    if let Some((v, rule)) = fixed {
+        let position = if v == a { sa.position } else { sb.position };
+        let cost = q.evaluate(position).max(0.0);
+        return (
+            Placement {
+                position,
+                cost,
+                rule,
+            },
+            q,
+        );
+    }
+    let (pa, pb) = (sa.position, sb.position);
+    let placed = match placement {
+        PlacementMode::Optimal => optimal_placement(&q, pa, pb),
+        PlacementMode::EndpointOrMidpoint => endpoint_placement(&q, pa, pb),
+    };
+    (placed, q)
+}
+
 /// What the loop keeps per vertex: what the placement and the checks read on every
 /// pair, side by side. Why the position is here too (the store has it in world units):
 /// one lookup instead of two, and no conversion per read; it is always exactly
@@ -338,28 +380,38 @@ impl Engine {
                 },
             );
         }
-        let faces: Vec<_> = self.store.faces().collect();
-        let area_offset = options.weighting.area_offset(self.mean_face_area(&faces));
-        for f in faces {
-            let [a, b, c] = self.store.face_vertices(f);
-            let (pa, pb, pc) = (
-                self.normalized_position(a),
-                self.normalized_position(b),
-                self.normalized_position(c),
-            );
-            self.original_normals.set(f, (pb - pa).cross(pc - pa));
+        let area_offset = options.weighting.area_offset(self.mean_face_area());
+        // The faces straight from the store, with its fields borrowed apart, rather than
+        // from a list of every face key first (32 MB on a 4M-triangle mesh, held at the
+        // setup's memory peak).
+        let Engine {
+            store,
+            state,
+            frame,
+            original_normals,
+            exact,
+            ..
+        } = self;
+        for f in store.faces() {
+            let [a, b, c] = store.face_vertices(f);
+            let position = |v: VertexKey| match state.get(v) {
+                Some(s) => s.position,
+                None => frame.to_normalized(DVec3::from_array(store.position(v))),
+            };
+            let (pa, pb, pc) = (position(a), position(b), position(c));
+            original_normals.set(f, (pb - pa).cross(pc - pa));
             let plane = match area_offset {
                 Some(extra) => WeightedPlane::from_triangle_area_plus(pa, pb, pc, extra),
                 None => WeightedPlane::from_triangle_unweighted(pa, pb, pc),
             };
             let q = plane.quadric();
             for v in [a, b, c] {
-                if let Some(s) = self.state.get_mut(v) {
+                if let Some(s) = state.get_mut(v) {
                     s.quadric += q;
                 }
             }
-            if let Some(exact) = &mut self.exact {
-                exact.add_face(f, self.store.face_edges(f), plane, q);
+            if let Some(exact) = exact {
+                exact.add_face(f, store.face_edges(f), plane, q);
             }
         }
         self.initialise_boundary(options, area_offset);
@@ -380,22 +432,35 @@ impl Engine {
             self.initialise_virtual_pairs(cleaned, keys, threshold, options);
         }
 
-        let edges: Vec<_> = self.store.edges().collect();
-        for e in edges {
-            let [a, b] = self.store.edge_vertices(e);
-            self.push_pair(a, b, Some(e));
+        // As `push_pair` for every edge, straight from the store (no list of every edge
+        // key first: 48 MB on a 4M-triangle mesh). No pair is waived yet, so there is
+        // nothing for `unwaive` to do.
+        let Engine {
+            store,
+            state,
+            exact,
+            settings,
+            queue,
+            ..
+        } = self;
+        for e in store.edges() {
+            let [a, b] = store.edge_vertices(e);
+            let (placed, _) = place(state, exact.as_ref(), settings.placement, a, b, Some(e));
+            queue.push(placed.cost, a, b, Some(e));
         }
     }
 
-    /// The mean area of `faces` in normalised units (degenerate faces count as 0), for
-    /// [`Weighting::Mixed`]; 0 when there are none.
-    fn mean_face_area(&self, faces: &[FaceKey]) -> f64 {
-        if faces.is_empty() {
+    /// The mean area of the store's faces in normalised units (degenerate faces count
+    /// as 0), for [`Weighting::Mixed`]; 0 when there are none.
+    fn mean_face_area(&self) -> f64 {
+        let count = self.store.face_count();
+        if count == 0 {
             return 0.0;
         }
-        let total: f64 = faces
-            .iter()
-            .map(|&f| {
+        let total: f64 = self
+            .store
+            .faces()
+            .map(|f| {
                 let [a, b, c] = self
                     .store
                     .face_vertices(f)
@@ -403,7 +468,7 @@ impl Engine {
                 unit_normal_and_area(a, b, c).map_or(0.0, |(_, area)| area)
             })
             .sum();
-        total / faces.len() as f64
+        total / count as f64
     }
 
     /// Border planes ([`BoundaryMode::Planes`]) or border locks ([`BoundaryMode::Locked`]).
@@ -505,36 +570,14 @@ impl Engine {
     /// The merged quadric of `a` and `b` (joined by edge `ab`, if any), where the new
     /// vertex would go and its cost, in normalised units. A locked end stays put.
     fn place(&self, a: VertexKey, b: VertexKey, ab: Option<EdgeKey>) -> (Placement, Quadric) {
-        let (sa, sb) = (&self.state[a], &self.state[b]);
-        let mut q = sa.quadric + sb.quadric;
-        if let Some(exact) = &self.exact {
-            q -= exact.edge(ab);
-        }
-        let fixed = if sa.locked {
-            Some((a, PlacementRule::FirstEnd))
-        } else if sb.locked {
-            Some((b, PlacementRule::SecondEnd))
-        } else {
-            None
-        };
-        if let Some((v, rule)) = fixed {
-            let position = if v == a { sa.position } else { sb.position };
-            let cost = q.evaluate(position).max(0.0);
-            return (
-                Placement {
-                    position,
-                    cost,
-                    rule,
-                },
-                q,
-            );
-        }
-        let (pa, pb) = (sa.position, sb.position);
-        let placed = match self.settings.placement {
-            PlacementMode::Optimal => optimal_placement(&q, pa, pb),
-            PlacementMode::EndpointOrMidpoint => endpoint_placement(&q, pa, pb),
-        };
-        (placed, q)
+        place(
+            &self.state,
+            self.exact.as_ref(),
+            self.settings.placement,
+            a,
+            b,
+            ab,
+        )
     }
 
     fn push_pair(&mut self, a: VertexKey, b: VertexKey, ab: Option<EdgeKey>) {
