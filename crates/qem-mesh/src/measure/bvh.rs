@@ -13,6 +13,7 @@
 //! when it is farther than the pruning bound; the answers themselves come from the
 //! exact `f64` triangle distances at the leaves.
 
+use super::facing::MIN_PRUNING_LENGTH;
 use super::{cross, length, sub, triangle_distance2, P3};
 use crate::input::IndexedMesh;
 
@@ -243,7 +244,8 @@ impl TriangleBvh {
     /// the corners by value and reorders them in place, so the build needs no second
     /// copy (a large mesh's corners are 72 bytes per triangle). Triangles are numbered
     /// with `u32`: at most `u32::MAX` of them are indexed (about 300 GB of corners), the
-    /// rest are left out.
+    /// rest are left out. Corners should be finite (as a validated mesh's are): a
+    /// triangle with a NaN corner is never found by the searches.
     pub fn from_corners(mut corners: Vec<[P3; 3]>) -> (TriangleBvh, Vec<u32>) {
         corners.truncate(u32::MAX as usize);
         let (nodes, slots, root) = build(&mut corners);
@@ -287,9 +289,10 @@ impl TriangleBvh {
             *slot = (node.lane_distance2(i, p), i);
         }
         // Nearest first, by a fixed network of five exchanges (a library sort of four
-        // was 14% of `qem measure`'s instructions); equal distances keep their lane
-        // order, so the walk is the same on every run. (Only the walk's speed depends
-        // on the order: every child within the bound is visited.)
+        // was 14% of `qem measure`'s instructions). Not stable, but fixed: the same
+        // distances give the same order on every run. (Only the walk's speed depends on
+        // the order: every child within the bound is visited, and the answers are
+        // ranked by distance and index.)
         for (x, y) in [(0, 1), (2, 3), (0, 2), (1, 3), (1, 2)] {
             if by_distance[y].0 < by_distance[x].0 {
                 by_distance.swap(x, y);
@@ -409,7 +412,9 @@ impl TriangleBvh {
             let [a, b, c] = self.corners[i];
             let d2 = triangle_distance2(p, a, b, c);
             best2.set(best2.get().min(d2));
-            if d2 > bound(best2.get()) {
+            // A NaN distance (a NaN corner or point) makes no candidate: it would sort
+            // among the nearest under `total_cmp` and could take a slot.
+            if d2.is_nan() || d2 > bound(best2.get()) {
                 return;
             }
             let entry = (d2, i as u32);
@@ -622,8 +627,9 @@ fn wide_node_count(n: usize) -> usize {
 
 /// Sets the box of the unit normals under each child of each node, rounded outward to
 /// `f32`, bottom-up (a child node always comes after its parent, see [`build`]). A
-/// triangle whose normal's length under- or overflows (or is NaN) counts as facing
-/// every way; a zero-area one has no direction and no say.
+/// triangle whose normal is shorter than [`MIN_PRUNING_LENGTH`] (but not zero),
+/// infinite or NaN counts as facing every way; a zero-area one has no direction and no
+/// say.
 fn fill_normal_boxes(nodes: &mut [WideNode], corners: &[[P3; 3]]) {
     for w in (0..nodes.len()).rev() {
         for i in 0..usize::from(nodes[w].lanes) {
@@ -634,7 +640,7 @@ fn fill_normal_boxes(nodes: &mut [WideNode], corners: &[[P3; 3]]) {
                 for [a, b, c] in &corners[first..first + count] {
                     let normal = cross(sub(*b, *a), sub(*c, *a));
                     let length = length(normal);
-                    if length > 0.0 && length.is_finite() {
+                    if length >= MIN_PRUNING_LENGTH && length.is_finite() {
                         let unit = normal.map(|x| x / length);
                         bounds.grow(&Box32::around(unit, unit));
                     } else if normal != [0.0; 3] {

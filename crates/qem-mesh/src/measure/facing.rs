@@ -22,6 +22,14 @@ use super::{cross, dot, length, sub, triangle_distance2, TriangleBvh, P3};
 /// ten times that, so rounding never hides a triangle at right angles.
 const FACING_MARGIN: f32 = 1e-5;
 
+/// The shortest raw normal (of a query or of a triangle) that may skip a subtree by the
+/// normal boxes. Why a floor: the leaves ask the sign of the raw dot product, which
+/// underflows to 0 (counted as facing away) when both normals are tiny, even where the
+/// unit normals agree; with both at least this long and the unit dot product above
+/// [`FACING_MARGIN`], the raw one is at least 1e-205, far from underflow. (The
+/// simplifier never asks about such faces: it refuses near-zero-area faces first.)
+pub(super) const MIN_PRUNING_LENGTH: f64 = 1e-100;
+
 /// The relative widening of the query cube before it is rounded to `f32`: 16 times
 /// the conversion's rounding (2^-24), so the `f32` cube always holds the `f64` one.
 const CUBE_WIDENING: f64 = 1e-6;
@@ -47,8 +55,8 @@ impl TriangleBvh {
         // The cube around the ball, widened before it is rounded to f32: by far more
         // than the rounding of the f64 sums and of the conversion (each at most 2^-24
         // of |x| + reach), plus an absolute bit for a cube around 0. (A NaN radius
-        // gives a NaN cube, which no box meets: no triangle is within a NaN distance
-        // either.)
+        // gives a NaN cube, which opens every child, see `open`; the leaves' exact
+        // test then finds no triangle within a NaN distance.)
         let reach = radius2.sqrt();
         let widen = |x: f64| (x.abs() + reach) * CUBE_WIDENING + f64::from(f32::MIN_POSITIVE);
         let cube_lo = p.map(|x| (x - reach - widen(x)) as f32);
@@ -95,8 +103,10 @@ impl WideNode {
     /// each box is from the cube along each axis (positive: apart), the largest of the
     /// six, then one comparison per lane, which the compiler turns into four-lane
     /// instructions. (`x - y ≤ 0` exactly when `x ≤ y`: subtraction is exact in sign,
-    /// gradual underflow included. The only NaN is `∞ − ∞`, from an unused child's
-    /// empty box against an infinite cube; the lane mask closes those.)
+    /// gradual underflow included. A NaN gap — `∞ − ∞` from an infinite cube against
+    /// an unused child's empty box or a box beyond `f32`'s range, or a NaN cube — loses
+    /// every comparison, so it never counts as apart: such a child is opened, which is
+    /// always safe, and the lane mask closes unused ones.)
     // Lane loops: the index form is the one that reads as lanes and vectorises.
     #[allow(clippy::needless_range_loop)]
     #[inline(always)]
@@ -136,12 +146,12 @@ impl WideNode {
     }
 }
 
-/// `v` scaled to unit length in `f32`, or `None` when its length is zero, NaN or
-/// infinite (such a direction is never known to agree with a box of normals, so no
-/// subtree is skipped for it).
+/// `v` scaled to unit length in `f32`, or `None` when its length is NaN, infinite or
+/// below [`MIN_PRUNING_LENGTH`] (such a direction is never known to agree with a box
+/// of normals, so no subtree is skipped for it).
 fn unit_direction(v: P3) -> Option<[f32; 3]> {
     let length = length(v);
-    (length > 0.0 && length.is_finite()).then(|| v.map(|x| (x / length) as f32))
+    (length >= MIN_PRUNING_LENGTH && length.is_finite()).then(|| v.map(|x| (x / length) as f32))
 }
 
 #[cfg(test)]

@@ -95,8 +95,9 @@ impl InputSurface {
 
     /// Gives each face its own input triangle as its first hint: `faces` lists the
     /// store's `face_count` faces in the order of the cleaned mesh's triangles they
-    /// were made from, `slots` is what [`new`](Self::new) returned. When the two do not correspond one
-    /// to one (the store refused some triangle), no face gets a hint yet.
+    /// were made from, `slots` is what [`new`](Self::new) returned. When the two do
+    /// not correspond one to one (the store refused some triangle), no face gets a
+    /// hint yet.
     ///
     /// Why seed the hints: without one, a face's first test is a full nearest search
     /// (on the dragon at ratio 0.1, about 9 in 10 of the full searches). Any triangle

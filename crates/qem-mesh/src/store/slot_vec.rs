@@ -19,7 +19,11 @@ pub(crate) struct SlotVec<K, V> {
     key: PhantomData<K>,
 }
 
-/// The slot index of a key (the low half of slotmap's documented `as_ffi` form).
+/// The slot index of a key: the low half of `as_ffi`. slotmap documents `as_ffi` only
+/// as a value `from_ffi` turns back into the key; that its low half is the slot index
+/// (and the high half the version) is how slotmap 1.x lays it out, which the store
+/// relies on too (its packed records). The test `low_halves_are_slot_indices` fails if
+/// a new version lays keys out otherwise.
 fn slot_index<K: Key>(key: K) -> usize {
     key.data().as_ffi() as u32 as usize
 }
@@ -75,6 +79,20 @@ mod tests {
 
     slotmap::new_key_type! {
         struct TestKey;
+    }
+
+    /// Fresh keys' low halves are small, distinct and dense: what `SlotVec` (and the
+    /// store's packed records) take them to be. Were slotmap to lay keys out
+    /// otherwise, `for_keys` would size for the largest low half.
+    #[test]
+    fn low_halves_are_slot_indices() {
+        let mut keys: SlotMap<TestKey, ()> = SlotMap::with_key();
+        let n = 1000;
+        let mut low: Vec<usize> = (0..n).map(|_| slot_index(keys.insert(()))).collect();
+        low.sort_unstable();
+        low.dedup();
+        assert_eq!(low.len(), n);
+        assert!(low.iter().all(|&i| i <= n), "{:?}", &low[low.len() - 3..]);
     }
 
     #[test]
