@@ -51,8 +51,8 @@ pub(super) struct ExactQuadrics {
     /// is read only when it collapses or merges, about twice per contraction, and was
     /// 350 MB on a 4M-triangle mesh.
     face_planes: SlotVec<FaceKey, WeightedPlane>,
-    /// `Q_abc` of the faces that duplicates merged into (no longer one plane), by
-    /// slot. Rare: only duplicate faces merge. Only looked up, never iterated.
+    /// `Q_abc` of the faces that duplicates merged into (no longer one plane). Rare:
+    /// only duplicate faces merge. Only looked up, never iterated.
     merged_faces: HashMap<FaceKey, Quadric>,
     /// What the store merged, reused across contractions.
     log: ContractLog,
@@ -76,7 +76,9 @@ impl ExactQuadrics {
     /// Records `plane`, the plane of face `f`, whose edges are `edges`; `q` is its
     /// quadric (`plane.quadric()`, which the caller has already computed).
     pub fn add_face(&mut self, f: FaceKey, edges: [EdgeKey; 3], plane: WeightedPlane, q: Quadric) {
-        debug_assert_eq!(plane.quadric(), q);
+        // Bits, not values: a NaN entry (never seen in the normalised frame) is not
+        // equal to itself.
+        debug_assert!(plane.quadric().entries().map(f64::to_bits) == q.entries().map(f64::to_bits));
         self.face_planes.set(f, plane);
         for e in edges {
             self.add_edge_plane(e, q);
