@@ -29,11 +29,10 @@ const ARITY: usize = 4;
 /// Marks an id that is not in the heap.
 const ABSENT: u32 = u32::MAX;
 
-/// The slot index of a key: unique among live keys, and stable for as long as the key
-/// lives (the loop never inserts into the store, so slots are not reused under it).
-fn slot<K: Key>(key: K) -> usize {
-    (key.data().as_ffi() & u64::from(u32::MAX)) as usize
-}
+// The slot index of a key (the one definition, next to `SlotVec`): unique among live
+// keys, and stable for as long as the key lives (the loop never inserts into the store,
+// so slots are not reused under it).
+use crate::store::slot_index as slot;
 
 /// Slot keys as dense 32-bit numbers in `as_ffi` order, and back.
 ///

@@ -63,7 +63,7 @@ pub use build::BuildStats;
 pub use contract::{ContractError, ContractLog, ContractOutcome};
 use fan::{Fan, FanPool};
 pub use query::{EdgeClass, VertexClass};
-pub(crate) use slot_vec::SlotVec;
+pub(crate) use slot_vec::{slot_index, SlotVec};
 pub use validate::StoreError;
 
 slotmap::new_key_type! {

@@ -24,7 +24,7 @@ pub(crate) struct SlotVec<K, V> {
 /// (and the high half the version) is how slotmap 1.x lays it out, which the store
 /// relies on too (its packed records). The test `low_halves_are_slot_indices` fails if
 /// a new version lays keys out otherwise.
-fn slot_index<K: Key>(key: K) -> usize {
+pub(crate) fn slot_index<K: Key>(key: K) -> usize {
     key.data().as_ffi() as u32 as usize
 }
 
