@@ -16,6 +16,7 @@
 use super::facing::MIN_PRUNING_LENGTH;
 use super::{cross, length, sub, triangle_distance2, P3};
 use crate::input::IndexedMesh;
+use rayon::prelude::*;
 
 /// Triangles per leaf: small leaves keep the exact tests few, large enough to keep the
 /// tree shallow.
@@ -479,105 +480,39 @@ impl TriangleBvh {
 /// split and its two halves' splits: its children are the four quarter ranges (or a
 /// half, where the half is a leaf). Built straight into wide nodes, so the build never
 /// holds a binary node per range (56 bytes each, about 134 MB on the 4M sphere).
+///
+/// Three passes, so that no pass reads corners out of order: [`partition`] puts every
+/// triangle in its leaf (on both cores), the corners move to leaf order, [`wide_nodes`]
+/// lays out the nodes (which needs only the range sizes), and [`fill_boxes`] fills in
+/// the boxes bottom-up. Why: building top-down with each range's box computed as its
+/// split was made read every triangle's 72 bytes of corners at random, once per level,
+/// and was most of the index build, which is the longer half of the simplifier's setup.
 fn build(corners: &mut [[P3; 3]]) -> (Vec<WideNode>, Vec<u32>, Aabb) {
-    // Kept for the build only (24 bytes per triangle): recomputing them inside the
+    let mut root_bounds = Aabb::EMPTY;
+    for corner in corners.iter().flatten() {
+        root_bounds.grow(*corner);
+    }
+    // Kept for the split only (24 bytes per triangle): recomputing them inside the
     // median selection's comparisons made the dragon's index build about 0.3 s
-    // slower, and the build is on the critical path of the setup.
-    let centroid = |c: &[P3; 3]| -> P3 {
-        [
-            (c[0][0] + c[1][0] + c[2][0]) / 3.0,
-            (c[0][1] + c[1][1] + c[2][1]) / 3.0,
-            (c[0][2] + c[1][2] + c[2][2]) / 3.0,
-        ]
-    };
-    let centroids: Vec<P3> = corners.iter().map(centroid).collect();
+    // slower.
+    let centroids: Vec<P3> = corners
+        .par_iter()
+        .map(|c| {
+            [
+                (c[0][0] + c[1][0] + c[2][0]) / 3.0,
+                (c[0][1] + c[1][1] + c[2][1]) / 3.0,
+                (c[0][2] + c[1][2] + c[2][2]) / 3.0,
+            ]
+        })
+        .collect();
     let mut order: Vec<u32> = (0..corners.len() as u32).collect();
-    // The box of the corners and the box of the centroids of `order[start..end]`.
-    let boxes_of = |order: &[u32]| {
-        let mut bounds = Aabb::EMPTY;
-        let mut centroid_box = Aabb::EMPTY;
-        for &t in order {
-            for corner in corners[t as usize] {
-                bounds.grow(corner);
-            }
-            centroid_box.grow(centroids[t as usize]);
-        }
-        (bounds, centroid_box)
-    };
-    // Splits `order[start..end]` at its median along the longest axis of its
-    // centroids' box; the middle index.
-    let split = |order: &mut [u32], start: usize, end: usize, centroid_box: &Aabb| {
-        let extent = sub(centroid_box.hi, centroid_box.lo);
-        let axis = if extent[0] >= extent[1] && extent[0] >= extent[2] {
-            0
-        } else if extent[1] >= extent[2] {
-            1
-        } else {
-            2
-        };
-        let mid = start + (end - start) / 2;
-        order[start..end].select_nth_unstable_by(mid - start, |&x, &y| {
-            centroids[x as usize][axis]
-                .total_cmp(&centroids[y as usize][axis])
-                .then(x.cmp(&y))
-        });
-        mid
-    };
-    let (root_bounds, root_centroids) = boxes_of(&order);
-    let mut nodes = Vec::with_capacity(wide_node_count(corners.len()));
-    if !corners.is_empty() {
-        nodes.push(WideNode::EMPTY);
-    }
-    // (wide node, its range in `order`, the range's centroid box)
-    let mut stack = vec![(0usize, 0usize, order.len(), root_centroids)];
-    while let Some((w, start, end, centroid_box)) = stack.pop() {
-        if nodes.is_empty() {
-            break;
-        }
-        // The children's ranges: the quarters of a range, a half where the half is a
-        // leaf; a root that is itself a leaf is its node's only child.
-        let mut ranges = [(0usize, 0usize); WIDTH];
-        let mut lanes = 0;
-        if end - start <= LEAF_SIZE {
-            ranges[0] = (start, end);
-            lanes = 1;
-        } else {
-            let mid = split(&mut order, start, end, &centroid_box);
-            for (s, e) in [(start, mid), (mid, end)] {
-                if e - s <= LEAF_SIZE {
-                    ranges[lanes] = (s, e);
-                    lanes += 1;
-                } else {
-                    let (_, half_centroids) = boxes_of(&order[s..e]);
-                    let m = split(&mut order, s, e, &half_centroids);
-                    ranges[lanes] = (s, m);
-                    ranges[lanes + 1] = (m, e);
-                    lanes += 2;
-                }
-            }
-        }
-        let mut wide = WideNode::EMPTY;
-        wide.lanes = lanes as u8;
-        for (i, &(s, e)) in ranges[..lanes].iter().enumerate() {
-            let (bounds, child_centroids) = boxes_of(&order[s..e]);
-            wide.set_child(i, &Box32::around(bounds.lo, bounds.hi), &Box32::EMPTY);
-            if e - s <= LEAF_SIZE {
-                wide.child[i] = s as u32;
-                wide.leaf_count[i] = (e - s) as u8;
-            } else {
-                wide.child[i] = nodes.len() as u32;
-                stack.push((nodes.len(), s, e, child_centroids));
-                nodes.push(WideNode::EMPTY);
-            }
-        }
-        nodes[w] = wide;
-    }
+    partition(&mut order, &centroids);
+    drop(centroids);
     let mut slots = vec![0u32; order.len()];
     for (slot, &t) in order.iter().enumerate() {
         slots[t as usize] = slot as u32;
     }
     drop(order);
-    drop(centroids);
     // Leaf order in place: each triangle swapped straight to its slot, cycle by
     // cycle (`destination` follows the triangles as they move).
     let mut destination = slots.clone();
@@ -589,8 +524,106 @@ fn build(corners: &mut [[P3; 3]]) -> (Vec<WideNode>, Vec<u32>, Aabb) {
         }
     }
     drop(destination);
-    fill_normal_boxes(&mut nodes, corners);
+    let mut nodes = wide_nodes(corners.len());
+    fill_boxes(&mut nodes, corners);
     (nodes, slots, root_bounds)
+}
+
+/// Ranges at least this long are split on both cores (below it, handing work to rayon
+/// costs more than it saves).
+const PARALLEL_PARTITION: usize = 1 << 14;
+
+/// Reorders `order` (triangle numbers) so that every range of the binary tree holds
+/// its triangles: a range of more than [`LEAF_SIZE`] is split at its middle, the
+/// lower half holding the triangles whose centroids come first along the longest axis
+/// of the range's centroid box (by coordinate, then by number).
+///
+/// Each range is split by one selection on its own elements, whichever core does it
+/// and whenever, so the result is the same with any number of threads.
+fn partition(order: &mut [u32], centroids: &[P3]) {
+    if order.len() <= LEAF_SIZE {
+        return;
+    }
+    let mut centroid_box = Aabb::EMPTY;
+    for &t in order.iter() {
+        centroid_box.grow(centroids[t as usize]);
+    }
+    let extent = sub(centroid_box.hi, centroid_box.lo);
+    let axis = if extent[0] >= extent[1] && extent[0] >= extent[2] {
+        0
+    } else if extent[1] >= extent[2] {
+        1
+    } else {
+        2
+    };
+    let mid = order.len() / 2;
+    order.select_nth_unstable_by(mid, |&x, &y| {
+        centroids[x as usize][axis]
+            .total_cmp(&centroids[y as usize][axis])
+            .then(x.cmp(&y))
+    });
+    let parallel = order.len() >= PARALLEL_PARTITION;
+    let (lower, upper) = order.split_at_mut(mid);
+    if parallel {
+        rayon::join(
+            || partition(lower, centroids),
+            || partition(upper, centroids),
+        );
+    } else {
+        partition(lower, centroids);
+        partition(upper, centroids);
+    }
+}
+
+/// The nodes of the tree over `n` triangles in leaf order, with their children and
+/// leaf ranges set and every box empty (see [`fill_boxes`]): the ranges of
+/// [`partition`], two binary levels a node, numbered in the order a depth-first walk
+/// (last child first) meets them.
+fn wide_nodes(n: usize) -> Vec<WideNode> {
+    let mut nodes = Vec::with_capacity(wide_node_count(n));
+    if n == 0 {
+        return nodes;
+    }
+    nodes.push(WideNode::EMPTY);
+    // (wide node, its range of triangles)
+    let mut stack = vec![(0usize, 0usize, n)];
+    while let Some((w, start, end)) = stack.pop() {
+        // The children's ranges: the quarters of a range, a half where the half is a
+        // leaf; a root that is itself a leaf is its node's only child.
+        let mut ranges = [(0usize, 0usize); WIDTH];
+        let mut lanes = 0;
+        if end - start <= LEAF_SIZE {
+            ranges[0] = (start, end);
+            lanes = 1;
+        } else {
+            let mid = start + (end - start) / 2;
+            for (s, e) in [(start, mid), (mid, end)] {
+                if e - s <= LEAF_SIZE {
+                    ranges[lanes] = (s, e);
+                    lanes += 1;
+                } else {
+                    let m = s + (e - s) / 2;
+                    ranges[lanes] = (s, m);
+                    ranges[lanes + 1] = (m, e);
+                    lanes += 2;
+                }
+            }
+        }
+        let mut wide = WideNode::EMPTY;
+        wide.lanes = lanes as u8;
+        for (i, &(s, e)) in ranges[..lanes].iter().enumerate() {
+            if e - s <= LEAF_SIZE {
+                wide.child[i] = s as u32;
+                wide.leaf_count[i] = (e - s) as u8;
+            } else {
+                wide.child[i] = nodes.len() as u32;
+                stack.push((nodes.len(), s, e));
+                nodes.push(WideNode::EMPTY);
+            }
+        }
+        nodes[w] = wide;
+    }
+    nodes
 }
 
 /// How many nodes [`build`] makes for `n` triangles: one if there are any, plus those
@@ -625,41 +658,51 @@ fn wide_node_count(n: usize) -> usize {
     }
 }
 
-/// Sets the box of the unit normals under each child of each node, rounded outward to
-/// `f32`, bottom-up (a child node always comes after its parent, see [`build`]). A
-/// triangle whose normal is shorter than [`MIN_PRUNING_LENGTH`] (but not zero),
-/// infinite or NaN counts as facing every way; a zero-area one has no direction and no
-/// say.
-fn fill_normal_boxes(nodes: &mut [WideNode], corners: &[[P3; 3]]) {
+/// Sets the boxes of each child of each node, bottom-up (a child node always comes
+/// after its parent, see [`wide_nodes`]): the box of its corners and the box of its
+/// unit normals, both rounded outward to `f32`. A triangle whose normal is shorter
+/// than [`MIN_PRUNING_LENGTH`] (but not zero), infinite or NaN counts as facing every
+/// way; a zero-area one has no direction and no say.
+///
+/// An inner child's position box is the union of its node's lanes: the same bits as
+/// rounding the `f64` box of all its corners, since rounding outward is monotone
+/// (the least of the rounded values is the rounded least value).
+fn fill_boxes(nodes: &mut [WideNode], corners: &[[P3; 3]]) {
     for w in (0..nodes.len()).rev() {
         for i in 0..usize::from(nodes[w].lanes) {
-            let mut bounds = Box32::EMPTY;
+            let mut position = Box32::EMPTY;
+            let mut normals = Box32::EMPTY;
             let count = usize::from(nodes[w].leaf_count[i]);
             let first = nodes[w].child[i] as usize;
             if count > 0 {
-                for [a, b, c] in &corners[first..first + count] {
+                let triangles = &corners[first..first + count];
+                let mut bounds = Aabb::EMPTY;
+                for corner in triangles.iter().flatten() {
+                    bounds.grow(*corner);
+                }
+                position = Box32::around(bounds.lo, bounds.hi);
+                for [a, b, c] in triangles {
                     let normal = cross(sub(*b, *a), sub(*c, *a));
                     let length = length(normal);
                     if length >= MIN_PRUNING_LENGTH && length.is_finite() {
                         let unit = normal.map(|x| x / length);
-                        bounds.grow(&Box32::around(unit, unit));
+                        normals.grow(&Box32::around(unit, unit));
                     } else if normal != [0.0; 3] {
-                        bounds.grow(&Box32::around([-1.0; 3], [1.0; 3]));
+                        normals.grow(&Box32::around([-1.0; 3], [1.0; 3]));
                     }
                 }
             } else {
                 let child = &nodes[first];
                 for j in 0..usize::from(child.lanes) {
-                    bounds.grow(&Box32 {
-                        lo: [0, 1, 2].map(|k| child.normal_lo[k][j]),
-                        hi: [0, 1, 2].map(|k| child.normal_hi[k][j]),
-                    });
+                    let lane = |lo: &[[f32; WIDTH]; 3], hi: &[[f32; WIDTH]; 3]| Box32 {
+                        lo: [0, 1, 2].map(|k| lo[k][j]),
+                        hi: [0, 1, 2].map(|k| hi[k][j]),
+                    };
+                    position.grow(&lane(&child.lo, &child.hi));
+                    normals.grow(&lane(&child.normal_lo, &child.normal_hi));
                 }
             }
-            for k in 0..3 {
-                nodes[w].normal_lo[k][i] = bounds.lo[k];
-                nodes[w].normal_hi[k][i] = bounds.hi[k];
-            }
+            nodes[w].set_child(i, &position, &normals);
         }
     }
 }
