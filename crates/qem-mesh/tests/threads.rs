@@ -1,5 +1,6 @@
-//! The parallel phases (cleaning, store building, virtual pairs) give the same result
-//! with one thread as with several: every output is compared bit for bit between a
+//! The parallel phases (cleaning, store building, virtual pairs, the index of the input
+//! surface, the quadrics' and pairs' setup) give the same result with one thread as with
+//! several: every output is compared bit for bit between a
 //! rayon pool of 1 thread and pools of 2 and 3 threads.
 //!
 //! The inputs are large enough (tens of thousands of triangles) for rayon to split the
@@ -7,6 +8,7 @@
 mod common;
 
 use qem_mesh::clean::{clean, CleanOptions};
+use qem_mesh::measure::TriangleBvh;
 use qem_mesh::pairs::{virtual_pairs, GridOptions};
 use qem_mesh::simplify::{simplify, Length, SimplifyOptions, Target};
 use qem_mesh::{IndexedMesh, MeshStore};
@@ -142,6 +144,40 @@ fn virtual_pairs_are_the_same_on_1_2_and_3_threads() {
             on_threads(threads, || virtual_pairs(&points, &options, odd)),
             one
         );
+    }
+}
+
+/// The index's leaf order: where each triangle went, and the corners in that order.
+fn index_dump(mesh: &IndexedMesh) -> (Vec<u32>, Vec<[[u64; 3]; 3]>) {
+    let (index, slots) = TriangleBvh::with_slots(mesh);
+    let corners = (0..index.triangle_count() as u32)
+        .map(|i| index.corners(i).map(|c| c.map(f64::to_bits)))
+        .collect();
+    (slots, corners)
+}
+
+#[test]
+fn the_index_is_the_same_on_1_2_and_3_threads() {
+    let mesh = clean(&messy_soup(), &CleanOptions::DEFAULT).mesh;
+    // Above the size at which the index splits its ranges on both cores.
+    assert!(mesh.triangle_count() > 20_000, "{}", mesh.triangle_count());
+    let one = on_threads(1, || index_dump(&mesh));
+    for threads in [2, 3] {
+        assert!(on_threads(threads, || index_dump(&mesh)) == one);
+    }
+    // And the same searches: the triangles nearest to some points, in index terms.
+    let index = TriangleBvh::new(&mesh);
+    for threads in [2, 3] {
+        let other = on_threads(threads, || TriangleBvh::new(&mesh));
+        for p in mesh.positions.iter().step_by(97) {
+            let (mut near, mut near_other) = (Vec::new(), Vec::new());
+            let q = [p[0] + 1e-3, p[1] - 2e-3, p[2] + 5e-4];
+            assert_eq!(
+                index.nearest_triangles(q, 1.5, 1e-9, 8, &mut near),
+                other.nearest_triangles(q, 1.5, 1e-9, 8, &mut near_other)
+            );
+            assert_eq!(near, near_other);
+        }
     }
 }
 

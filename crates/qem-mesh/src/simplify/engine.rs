@@ -15,6 +15,7 @@ use qem_core::{
     endpoint_placement, optimal_placement, unit_normal_and_area, DVec3, Frame, Placement,
     PlacementRule, Quadric, WeightedPlane,
 };
+use rayon::prelude::*;
 use slotmap::{Key, SecondaryMap};
 use smallvec::SmallVec;
 use std::collections::HashSet;
@@ -94,6 +95,13 @@ fn place(
     };
     (placed, q)
 }
+
+/// Faces or edges handed to both cores at a time by [`Engine::initialise`]: large
+/// enough that rayon's hand-off is noise (a chunk is a few milliseconds of work), small
+/// enough that the chunk's results (about 64 bytes each) stay about a megabyte, not a
+/// copy per face of the mesh. (Small enough, too, that `tests/threads.rs` runs several
+/// chunks.)
+const SETUP_CHUNK: usize = 1 << 14;
 
 /// What the loop keeps per vertex: what the placement and the checks read on every
 /// pair, side by side. Why the position is here too (the store has it in world units):
@@ -381,39 +389,7 @@ impl Engine {
             );
         }
         let area_offset = options.weighting.area_offset(self.mean_face_area());
-        // The faces straight from the store, with its fields borrowed apart, rather than
-        // from a list of every face key first (32 MB on a 4M-triangle mesh, held at the
-        // setup's memory peak).
-        let Engine {
-            store,
-            state,
-            frame,
-            original_normals,
-            exact,
-            ..
-        } = self;
-        for f in store.faces() {
-            let [a, b, c] = store.face_vertices(f);
-            let position = |v: VertexKey| match state.get(v) {
-                Some(s) => s.position,
-                None => frame.to_normalized(DVec3::from_array(store.position(v))),
-            };
-            let (pa, pb, pc) = (position(a), position(b), position(c));
-            original_normals.set(f, (pb - pa).cross(pc - pa));
-            let plane = match area_offset {
-                Some(extra) => WeightedPlane::from_triangle_area_plus(pa, pb, pc, extra),
-                None => WeightedPlane::from_triangle_unweighted(pa, pb, pc),
-            };
-            let q = plane.quadric();
-            for v in [a, b, c] {
-                if let Some(s) = state.get_mut(v) {
-                    s.quadric += q;
-                }
-            }
-            if let Some(exact) = exact {
-                exact.add_face(f, store.face_edges(f), plane, q);
-            }
-        }
+        self.sum_face_planes(area_offset);
         self.initialise_boundary(options, area_offset);
         for &i in locked {
             if let Some(s) = keys.get(i as usize).and_then(|&v| self.state.get_mut(v)) {
@@ -432,9 +408,75 @@ impl Engine {
             self.initialise_virtual_pairs(cleaned, keys, threshold, options);
         }
 
-        // As `push_pair` for every edge, straight from the store (no list of every edge
-        // key first: 48 MB on a 4M-triangle mesh). No pair is waived yet, so there is
-        // nothing for `unwaive` to do.
+        self.queue_every_edge();
+    }
+
+    /// Each face's input normal, its plane in the exact quadrics and its quadric in
+    /// its vertices' sums, with the weighting's `area_offset`.
+    ///
+    /// The faces straight from the store, with its fields borrowed apart, rather than
+    /// from a list of every face key first (32 MB on a 4M-triangle mesh, held at the
+    /// setup's memory peak): a chunk of keys at a time, each face's normal and plane
+    /// computed on both cores, then summed into its vertices and edges in face order
+    /// (the order of the sums fixes their bits, so it is the same on any number of
+    /// threads).
+    fn sum_face_planes(&mut self, area_offset: Option<f64>) {
+        let Engine {
+            store,
+            state,
+            frame,
+            original_normals,
+            exact,
+            ..
+        } = self;
+        let mut faces = store.faces();
+        let mut chunk: Vec<FaceKey> = Vec::with_capacity(SETUP_CHUNK);
+        let mut planes: Vec<(DVec3, WeightedPlane)> = Vec::with_capacity(SETUP_CHUNK);
+        loop {
+            chunk.clear();
+            chunk.extend(faces.by_ref().take(SETUP_CHUNK));
+            if chunk.is_empty() {
+                break;
+            }
+            let (shared_store, shared_state) = (&*store, &*state);
+            chunk
+                .par_iter()
+                .map(|&f| {
+                    let position = |v: VertexKey| match shared_state.get(v) {
+                        Some(s) => s.position,
+                        None => frame.to_normalized(DVec3::from_array(shared_store.position(v))),
+                    };
+                    let [pa, pb, pc] = shared_store.face_vertices(f).map(position);
+                    let plane = match area_offset {
+                        Some(extra) => WeightedPlane::from_triangle_area_plus(pa, pb, pc, extra),
+                        None => WeightedPlane::from_triangle_unweighted(pa, pb, pc),
+                    };
+                    ((pb - pa).cross(pc - pa), plane)
+                })
+                .collect_into_vec(&mut planes);
+            for (&f, &(normal, plane)) in chunk.iter().zip(&planes) {
+                original_normals.set(f, normal);
+                let q = plane.quadric();
+                for v in store.face_vertices(f) {
+                    if let Some(s) = state.get_mut(v) {
+                        s.quadric += q;
+                    }
+                }
+                if let Some(exact) = exact {
+                    exact.add_face(f, store.face_edges(f), plane, q);
+                }
+            }
+        }
+    }
+
+    /// Queues every edge as a pair, at its placement's cost.
+    ///
+    /// As `push_pair` for every edge, straight from the store (no list of every edge
+    /// key first: 48 MB on a 4M-triangle mesh). No pair is waived yet, so there is
+    /// nothing for `unwaive` to do. The placements of a chunk of edges are solved on
+    /// both cores, then queued in edge order (the queue's pop order depends only on
+    /// the keys, and the order of pushes is the same anyway).
+    fn queue_every_edge(&mut self) {
         let Engine {
             store,
             state,
@@ -443,10 +485,36 @@ impl Engine {
             queue,
             ..
         } = self;
-        for e in store.edges() {
-            let [a, b] = store.edge_vertices(e);
-            let (placed, _) = place(state, exact.as_ref(), settings.placement, a, b, Some(e));
-            queue.push(placed.cost, a, b, Some(e));
+        let mut edges = store.edges();
+        let mut chunk: Vec<EdgeKey> = Vec::with_capacity(SETUP_CHUNK);
+        let mut costs: Vec<f64> = Vec::with_capacity(SETUP_CHUNK);
+        loop {
+            chunk.clear();
+            chunk.extend(edges.by_ref().take(SETUP_CHUNK));
+            if chunk.is_empty() {
+                break;
+            }
+            let (shared_store, shared_state, shared_exact) = (&*store, &*state, exact.as_ref());
+            chunk
+                .par_iter()
+                .map(|&e| {
+                    let [a, b] = shared_store.edge_vertices(e);
+                    place(
+                        shared_state,
+                        shared_exact,
+                        settings.placement,
+                        a,
+                        b,
+                        Some(e),
+                    )
+                    .0
+                    .cost
+                })
+                .collect_into_vec(&mut costs);
+            for (&e, &cost) in chunk.iter().zip(&costs) {
+                let [a, b] = store.edge_vertices(e);
+                queue.push(cost, a, b, Some(e));
+            }
         }
     }
 
