@@ -481,7 +481,7 @@ impl TriangleBvh {
 /// half, where the half is a leaf). Built straight into wide nodes, so the build never
 /// holds a binary node per range (56 bytes each, about 134 MB on the 4M sphere).
 ///
-/// Three passes, so that no pass reads corners out of order: [`partition`] puts every
+/// Four steps, so that none reads corners out of order: [`partition`] puts every
 /// triangle in its leaf (on both cores), the corners move to leaf order, [`wide_nodes`]
 /// lays out the nodes (which needs only the range sizes), and [`fill_boxes`] fills in
 /// the boxes bottom-up. Why: building top-down with each range's box computed as its
@@ -495,13 +495,17 @@ fn build(corners: &mut [[P3; 3]]) -> (Vec<WideNode>, Vec<u32>, Aabb) {
     // Kept for the split only (24 bytes per triangle): recomputing them inside the
     // median selection's comparisons made the dragon's index build about 0.3 s
     // slower.
+    // A NaN coordinate (from infinite or NaN corners, which callers should not pass)
+    // becomes the one canonical NaN: the split's `total_cmp` orders NaNs by their bits,
+    // which arithmetic does not fix, and the tree must not depend on them.
+    let canonical = |x: f64| if x.is_nan() { f64::NAN } else { x };
     let centroids: Vec<P3> = corners
         .par_iter()
         .map(|c| {
             [
-                (c[0][0] + c[1][0] + c[2][0]) / 3.0,
-                (c[0][1] + c[1][1] + c[2][1]) / 3.0,
-                (c[0][2] + c[1][2] + c[2][2]) / 3.0,
+                canonical((c[0][0] + c[1][0] + c[2][0]) / 3.0),
+                canonical((c[0][1] + c[1][1] + c[2][1]) / 3.0),
+                canonical((c[0][2] + c[1][2] + c[2][2]) / 3.0),
             ]
         })
         .collect();
@@ -530,7 +534,8 @@ fn build(corners: &mut [[P3; 3]]) -> (Vec<WideNode>, Vec<u32>, Aabb) {
 }
 
 /// Ranges at least this long are split on both cores (below it, handing work to rayon
-/// costs more than it saves).
+/// costs more than it saves). `tests/threads.rs` builds an index above this size to
+/// cover the parallel path; raise both together.
 const PARALLEL_PARTITION: usize = 1 << 14;
 
 /// Reorders `order` (triangle numbers) so that every range of the binary tree holds
@@ -665,8 +670,11 @@ fn wide_node_count(n: usize) -> usize {
 /// way; a zero-area one has no direction and no say.
 ///
 /// An inner child's position box is the union of its node's lanes: the same bits as
-/// rounding the `f64` box of all its corners, since rounding outward is monotone
-/// (the least of the rounded values is the rounded least value).
+/// rounding the `f64` box of all its corners, up to the sign of a zero bound, since
+/// rounding outward is monotone (the least of the rounded values is the rounded least
+/// value). (`min` and `max` of 0.0 and −0.0 keep whichever came first, so the sign of
+/// a zero bound depends on the order of the corners; every reader compares or squares
+/// the bounds, where the two zeros are equal.)
 fn fill_boxes(nodes: &mut [WideNode], corners: &[[P3; 3]]) {
     for w in (0..nodes.len()).rev() {
         for i in 0..usize::from(nodes[w].lanes) {
@@ -807,6 +815,48 @@ mod tests {
         assert!(seen.iter().all(|&n| n == 1), "{seen:?}");
         for (i, &slot) in slots.iter().enumerate() {
             assert_eq!(bvh.corners(slot), corners[i]);
+        }
+    }
+
+    /// The tree does not depend on the bits of NaN coordinates (which arithmetic does
+    /// not fix): corners with NaNs of assorted payloads give the same leaf order as the
+    /// same corners with one NaN throughout.
+    #[test]
+    fn nan_payloads_do_not_change_the_tree() {
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        for n in [6usize, 9, 17, 40, 100] {
+            for _ in 0..20 {
+                let mut with_payloads = Vec::new();
+                let mut canonical = Vec::new();
+                for _ in 0..n {
+                    let mut triangle = [[0.0; 3]; 3];
+                    let mut plain = [[0.0; 3]; 3];
+                    for (corner, plain_corner) in triangle.iter_mut().zip(plain.iter_mut()) {
+                        for (x, y) in corner.iter_mut().zip(plain_corner.iter_mut()) {
+                            let r = next();
+                            if r % 4 == 0 {
+                                // A quiet NaN with a payload, of either sign.
+                                *x = f64::from_bits(0x7ff8_0000_0000_0000 | (r >> 20) | (r << 63));
+                                *y = f64::NAN;
+                            } else {
+                                *x = (r >> 11) as f64 / (1u64 << 53) as f64;
+                                *y = *x;
+                            }
+                        }
+                    }
+                    with_payloads.push(triangle);
+                    canonical.push(plain);
+                }
+                let (_, slots) = TriangleBvh::from_corners(with_payloads);
+                let (_, expected) = TriangleBvh::from_corners(canonical);
+                assert_eq!(slots, expected, "{n} triangles");
+            }
         }
     }
 }

@@ -97,10 +97,10 @@ fn place(
 }
 
 /// Faces or edges handed to both cores at a time by [`Engine::initialise`]: large
-/// enough that rayon's hand-off is noise (a chunk is a few milliseconds of work), small
-/// enough that the chunk's results (about 64 bytes each) stay about a megabyte, not a
-/// copy per face of the mesh. (Small enough, too, that `tests/threads.rs` runs several
-/// chunks.)
+/// enough that rayon's hand-off is noise (16k placements are about 10 M instructions,
+/// at about 600 each under callgrind), small enough that the chunk's results (144 bytes
+/// a face, 24 an edge) stay a few megabytes, not a copy per face of the mesh. (Small
+/// enough, too, that `tests/threads.rs` runs several chunks.)
 const SETUP_CHUNK: usize = 1 << 14;
 
 /// What the loop keeps per vertex: what the placement and the checks read on every
@@ -431,7 +431,7 @@ impl Engine {
         } = self;
         let mut faces = store.faces();
         let mut chunk: Vec<FaceKey> = Vec::with_capacity(SETUP_CHUNK);
-        let mut planes: Vec<(DVec3, WeightedPlane)> = Vec::with_capacity(SETUP_CHUNK);
+        let mut planes: Vec<(DVec3, WeightedPlane, Quadric)> = Vec::with_capacity(SETUP_CHUNK);
         loop {
             chunk.clear();
             chunk.extend(faces.by_ref().take(SETUP_CHUNK));
@@ -451,12 +451,11 @@ impl Engine {
                         Some(extra) => WeightedPlane::from_triangle_area_plus(pa, pb, pc, extra),
                         None => WeightedPlane::from_triangle_unweighted(pa, pb, pc),
                     };
-                    ((pb - pa).cross(pc - pa), plane)
+                    ((pb - pa).cross(pc - pa), plane, plane.quadric())
                 })
                 .collect_into_vec(&mut planes);
-            for (&f, &(normal, plane)) in chunk.iter().zip(&planes) {
+            for (&f, &(normal, plane, q)) in chunk.iter().zip(&planes) {
                 original_normals.set(f, normal);
-                let q = plane.quadric();
                 for v in store.face_vertices(f) {
                     if let Some(s) = state.get_mut(v) {
                         s.quadric += q;
@@ -487,7 +486,8 @@ impl Engine {
         } = self;
         let mut edges = store.edges();
         let mut chunk: Vec<EdgeKey> = Vec::with_capacity(SETUP_CHUNK);
-        let mut costs: Vec<f64> = Vec::with_capacity(SETUP_CHUNK);
+        // Each edge's ends with its cost, so the queueing does not look the edge up again.
+        let mut costed: Vec<(VertexKey, VertexKey, f64)> = Vec::with_capacity(SETUP_CHUNK);
         loop {
             chunk.clear();
             chunk.extend(edges.by_ref().take(SETUP_CHUNK));
@@ -499,20 +499,18 @@ impl Engine {
                 .par_iter()
                 .map(|&e| {
                     let [a, b] = shared_store.edge_vertices(e);
-                    place(
+                    let (placed, _) = place(
                         shared_state,
                         shared_exact,
                         settings.placement,
                         a,
                         b,
                         Some(e),
-                    )
-                    .0
-                    .cost
+                    );
+                    (a, b, placed.cost)
                 })
-                .collect_into_vec(&mut costs);
-            for (&e, &cost) in chunk.iter().zip(&costs) {
-                let [a, b] = store.edge_vertices(e);
+                .collect_into_vec(&mut costed);
+            for (&e, &(a, b, cost)) in chunk.iter().zip(&costed) {
                 queue.push(cost, a, b, Some(e));
             }
         }
