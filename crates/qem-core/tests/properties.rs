@@ -159,3 +159,30 @@ proptest! {
         prop_assert!(!placed.cost.is_nan());
     }
 }
+
+/// An entry for `magnitude`'s test: ordinary, tiny, huge, zero of either sign, NaN or
+/// infinite.
+fn any_entry() -> impl Strategy<Value = f64> {
+    prop_oneof![
+        -10.0..10.0f64,
+        -1e-300..1e-300f64,
+        Just(0.0),
+        Just(-0.0),
+        Just(f64::NAN),
+        Just(f64::INFINITY),
+        Just(f64::NEG_INFINITY),
+        Just(-f64::MAX),
+    ]
+}
+
+proptest! {
+    /// `magnitude` is the largest absolute entry with NaN entries passed over, bit for
+    /// bit what folding `f64::max` over the absolute entries from 0 gives (its first
+    /// definition; relative tolerances of the placement depend on it).
+    #[test]
+    fn magnitude_is_the_largest_absolute_entry(entries in proptest::array::uniform10(any_entry())) {
+        let q = Quadric::from_entries(entries);
+        let folded = entries.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        prop_assert_eq!(q.magnitude().to_bits(), folded.to_bits());
+    }
+}
