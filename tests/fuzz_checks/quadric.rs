@@ -60,6 +60,20 @@ pub fn quadric_solve(data: &[u8]) {
     );
     assert!(placed.cost >= 0.0, "negative cost {placed:?}");
     let fallback = endpoint_placement(&q, a, b);
+    // The ends' rule picks the least cost that is a number (an overflowing one, NaN,
+    // never wins), clamped at 0.
+    let mid = a * 0.5 + b * 0.5;
+    let least = [q.evaluate(mid), q.evaluate(a), q.evaluate(b)]
+        .into_iter()
+        .filter(|c| !c.is_nan())
+        .reduce(f64::min);
+    if let Some(least) = least {
+        assert_eq!(
+            fallback.cost,
+            least.max(0.0),
+            "the ends' rule did not pick the least cost: {fallback:?}"
+        );
+    }
     // When the cost overflows, comparisons mean nothing; the point must still be finite.
     if fallback.cost.is_finite() {
         assert!(

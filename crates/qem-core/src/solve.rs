@@ -217,8 +217,11 @@ pub fn endpoint_placement(q: &Quadric, a: DVec3, b: DVec3) -> Placement {
     };
     for (position, rule) in [(a, PlacementRule::FirstEnd), (b, PlacementRule::SecondEnd)] {
         let cost = q.evaluate(position);
-        // `total_cmp` keeps NaN (from an overflowing quadric) from winning.
-        if cost.total_cmp(&best.cost).is_lt() || best.cost.is_nan() {
+        // A NaN cost (an overflowing quadric, ∞ − ∞) never wins, and any number beats
+        // a NaN. (`total_cmp` alone would not do: it ranks a negative NaN, which is what
+        // x86 arithmetic makes, below every number.) Between numbers, `total_cmp`'s
+        // order: −0 before +0.
+        if !cost.is_nan() && (best.cost.is_nan() || cost.total_cmp(&best.cost).is_lt()) {
             best = Placement {
                 position,
                 cost,

@@ -155,6 +155,26 @@ fn huge_coordinates_give_finite_midpoint() {
 }
 
 #[test]
+fn an_overflowing_end_never_wins_over_a_finite_midpoint() {
+    // Q(p) = x² − 2e300·x: at the midpoint 0 it is 0; at x = 1e200 it is ∞ − ∞ = NaN
+    // (negative on x86, which `total_cmp` ranks below every number); at x = −1e200 it
+    // is +∞. The midpoint is the only end with a cost, and must be chosen.
+    let q = Quadric::from_entries([1.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1e300, 0.0, 0.0, 0.0]);
+    let (a, b) = (DVec3::new(1e200, 0.0, 0.0), DVec3::new(-1e200, 0.0, 0.0));
+    assert!(q.evaluate(a).is_nan() && q.evaluate(b) == f64::INFINITY);
+    assert_eq!(q.evaluate(DVec3::ZERO), 0.0);
+    for p in [
+        endpoint_placement(&q, a, b),
+        endpoint_placement(&q, b, a),
+        segment_placement(&q, a, b),
+        optimal_placement(&q, a, b),
+    ] {
+        assert_eq!(p.rule, PlacementRule::Midpoint);
+        assert_eq!((p.position, p.cost), (DVec3::ZERO, 0.0));
+    }
+}
+
+#[test]
 fn frame_maps_box_into_unit_cube_and_errors_back() {
     let f = Frame::from_bounds(DVec3::new(-10.0, 0.0, 0.0), DVec3::new(10.0, 10.0, 0.0));
     assert_eq!(f.scale(), 10.0);
