@@ -411,15 +411,15 @@ impl Engine {
         self.queue_every_edge();
     }
 
-    /// Each face's input normal, its plane in the exact quadrics and its quadric in
-    /// its vertices' sums, with the weighting's `area_offset`.
+    /// Records each face's input normal and its plane in the exact quadrics, and adds
+    /// its quadric to its vertices' sums, with the weighting's `area_offset`.
     ///
-    /// The faces straight from the store, with its fields borrowed apart, rather than
-    /// from a list of every face key first (32 MB on a 4M-triangle mesh, held at the
-    /// setup's memory peak): a chunk of keys at a time, each face's normal and plane
-    /// computed on both cores, then summed into its vertices and edges in face order
-    /// (the order of the sums fixes their bits, so it is the same on any number of
-    /// threads).
+    /// Reads the faces straight from the store, with its fields borrowed apart, rather
+    /// than from a list of every face key first (32 MB on a 4M-triangle mesh, held at
+    /// the setup's memory peak): a chunk of keys at a time, each face's normal, plane
+    /// and quadric computed on both cores, then summed into its vertices and edges in
+    /// face order (the order of the sums fixes their bits, so they are the same on any
+    /// number of threads).
     fn sum_face_planes(&mut self, area_offset: Option<f64>) {
         let Engine {
             store,
@@ -468,13 +468,12 @@ impl Engine {
         }
     }
 
-    /// Queues every edge as a pair, at its placement's cost.
-    ///
-    /// As `push_pair` for every edge, straight from the store (no list of every edge
-    /// key first: 48 MB on a 4M-triangle mesh). No pair is waived yet, so there is
-    /// nothing for `unwaive` to do. The placements of a chunk of edges are solved on
-    /// both cores, then queued in edge order (the queue's pop order depends only on
-    /// the keys, and the order of pushes is the same anyway).
+    /// Queues every edge as a pair, at its placement's cost: `push_pair` for every
+    /// edge, read straight from the store (no list of every edge key first: 48 MB on a
+    /// 4M-triangle mesh). No pair is waived yet, so there is nothing for `unwaive` to
+    /// do. The placements of a chunk of edges are solved on both cores, then queued in
+    /// edge order (the queue's pop order depends only on the keys, and the order of
+    /// pushes is the same as before anyway).
     fn queue_every_edge(&mut self) {
         let Engine {
             store,
