@@ -485,19 +485,19 @@ impl TriangleBvh {
 /// triangle in its leaf (on both cores), the corners move to leaf order, [`wide_nodes`]
 /// lays out the nodes (which needs only the range sizes), and [`fill_boxes`] fills in
 /// the boxes bottom-up. Why: building top-down with each range's box computed as its
-/// split was made read every triangle's 72 bytes of corners at random, once per level,
-/// and was most of the index build, which is the longer half of the simplifier's setup.
+/// split was made read every triangle's 72 bytes of corners at random, once per level;
+/// that was most of the index build, then the longer half of the simplifier's setup.
 fn build(corners: &mut [[P3; 3]]) -> (Vec<WideNode>, Vec<u32>, Aabb) {
     let mut root_bounds = Aabb::EMPTY;
     for corner in corners.iter().flatten() {
         root_bounds.grow(*corner);
     }
-    // Kept for the split only (24 bytes per triangle): recomputing them inside the
-    // median selection's comparisons made the dragon's index build about 0.3 s
-    // slower.
-    // A NaN coordinate (from infinite or NaN corners, which callers should not pass)
-    // becomes the one canonical NaN: the split's `total_cmp` orders NaNs by their bits,
-    // which arithmetic does not fix, and the tree must not depend on them.
+    // The centroids, kept for the split only (24 bytes per triangle): recomputing them
+    // inside the median selection's comparisons made the dragon's index build about
+    // 0.3 s slower. A NaN coordinate (from infinite or NaN corners, which callers
+    // should not pass) becomes the one canonical NaN: the split's `total_cmp` orders
+    // NaNs by their bits, which arithmetic does not fix, and the tree must not depend
+    // on them.
     let canonical = |x: f64| if x.is_nan() { f64::NAN } else { x };
     let centroids: Vec<P3> = corners
         .par_iter()
