@@ -9,7 +9,7 @@ use super::report::{SimplifyError, StopReason};
 use crate::clean::min_double_area;
 use crate::pairs::grid::{virtual_pairs, GridOptions};
 use crate::queue::PairQueue;
-use crate::store::{EdgeKey, FaceKey, MeshStore, SlotVec, VertexKey};
+use crate::store::{slot_index, EdgeKey, FaceKey, MeshStore, SlotVec, VertexKey};
 use crate::IndexedMesh;
 use qem_core::{
     endpoint_placement, optimal_placement, unit_normal_and_area, DVec3, Frame, Placement,
@@ -96,6 +96,21 @@ fn place(
     (placed, q)
 }
 
+/// The position of `v` in normalised units: its loop state's, or the store's converted
+/// for a vertex without one. (A free function so that the setup can read positions
+/// with the engine's fields borrowed apart.)
+fn normalized_position(
+    state: &VertexStates,
+    frame: &Frame,
+    store: &MeshStore,
+    v: VertexKey,
+) -> DVec3 {
+    match state.get(v) {
+        Some(s) => s.position,
+        None => frame.to_normalized(DVec3::from_array(store.position(v))),
+    }
+}
+
 /// Faces or edges handed to both cores at a time by [`Engine::initialise`]: large
 /// enough that rayon's hand-off is noise (16k placements are about 10 M instructions,
 /// at about 600 each under callgrind), small enough that the chunk's results (144 bytes
@@ -141,10 +156,9 @@ pub(super) struct VertexStates {
     slots: Vec<StateSlot>,
 }
 
-/// Slot index and version of a key.
+/// Slot index (the store's one definition, `slot_index`) and version of a key.
 fn split_key(v: VertexKey) -> (usize, u32) {
-    let ffi = v.data().as_ffi();
-    (ffi as u32 as usize, (ffi >> 32) as u32)
+    (slot_index(v), (v.data().as_ffi() >> 32) as u32)
 }
 
 impl VertexStates {
@@ -358,12 +372,7 @@ impl Engine {
     }
 
     pub fn normalized_position(&self, v: VertexKey) -> DVec3 {
-        match self.state.get(v) {
-            Some(s) => s.position,
-            None => self
-                .frame
-                .to_normalized(DVec3::from_array(self.store.position(v))),
-        }
+        normalized_position(&self.state, &self.frame, &self.store, v)
     }
 
     /// Face quadrics summed into vertex quadrics, border planes or locks, locked
@@ -442,11 +451,9 @@ impl Engine {
             chunk
                 .par_iter()
                 .map(|&f| {
-                    let position = |v: VertexKey| match shared_state.get(v) {
-                        Some(s) => s.position,
-                        None => frame.to_normalized(DVec3::from_array(shared_store.position(v))),
-                    };
-                    let [pa, pb, pc] = shared_store.face_vertices(f).map(position);
+                    let [pa, pb, pc] = shared_store
+                        .face_vertices(f)
+                        .map(|v| normalized_position(shared_state, frame, shared_store, v));
                     let plane = match area_offset {
                         Some(extra) => WeightedPlane::from_triangle_area_plus(pa, pb, pc, extra),
                         None => WeightedPlane::from_triangle_unweighted(pa, pb, pc),
