@@ -1,10 +1,10 @@
 //! Which contractions are allowed: fold-over (degenerate, flipped and sliver faces),
 //! topology (the link condition) and locks. Cheapest first; none allocates.
 
-use super::engine::Engine;
+use super::engine::{Engine, Settings};
 use crate::clean::cross_underflows;
 use crate::store::{EdgeClass, EdgeKey, FaceKey, VertexClass, VertexKey};
-use qem_core::DVec3;
+use qem_core::{DVec3, Frame};
 
 /// Why a contraction was refused (each has a counter in the report).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -29,7 +29,7 @@ pub(super) enum Rejection {
 
 /// `4√3·area / (l₀² + l₁² + l₂²)` from twice the area (`double_area`): 1 for an
 /// equilateral triangle, 0 for a degenerate one.
-fn quality(p0: DVec3, p1: DVec3, p2: DVec3, double_area: f64) -> f64 {
+pub(super) fn quality(p0: DVec3, p1: DVec3, p2: DVec3, double_area: f64) -> f64 {
     let sum = p0.distance_squared(p1) + p1.distance_squared(p2) + p2.distance_squared(p0);
     if sum > 0.0 {
         2.0 * 3f64.sqrt() * double_area / sum
@@ -42,7 +42,7 @@ fn quality(p0: DVec3, p1: DVec3, p2: DVec3, double_area: f64) -> f64 {
 /// `min_cos`: `old·new < min_cos·|old|·|new|`, compared in squares (`new_squared` is
 /// `|new|²`) so that no square root is taken.
 #[inline]
-fn turned_past(old: DVec3, new: DVec3, new_squared: f64, min_cos: f64) -> bool {
+pub(super) fn turned_past(old: DVec3, new: DVec3, new_squared: f64, min_cos: f64) -> bool {
     let dot = old.dot(new);
     let bound = min_cos * min_cos * old.length_squared() * new_squared;
     if min_cos >= 0.0 {
@@ -50,6 +50,20 @@ fn turned_past(old: DVec3, new: DVec3, new_squared: f64, min_cos: f64) -> bool {
     } else {
         dot < 0.0 && dot * dot > bound
     }
+}
+
+/// [`Engine::is_zero_area`], from the parts of a run it reads (the pass-based order
+/// uses it too).
+pub(super) fn is_zero_area(
+    frame: &Frame,
+    settings: &Settings,
+    world_corners: [[f64; 3]; 3],
+) -> bool {
+    let [p0, p1, p2] = world_corners.map(|c| frame.to_normalized(DVec3::from_array(c)));
+    let squared = (p1 - p0).cross(p2 - p0).length_squared();
+    squared.is_nan()
+        || squared <= settings.min_double_area_squared
+        || (settings.world_may_underflow && cross_underflows(world_corners))
 }
 
 impl Engine {
@@ -123,11 +137,7 @@ impl Engine {
     /// the input's when a placement leaves the input's box, making a relative test there
     /// stricter: a `simplify_soup` fuzz finding emptied the output that way).
     pub(super) fn is_zero_area(&self, world_corners: [[f64; 3]; 3]) -> bool {
-        let [p0, p1, p2] = world_corners.map(|c| self.frame.to_normalized(DVec3::from_array(c)));
-        let squared = (p1 - p0).cross(p2 - p0).length_squared();
-        squared.is_nan()
-            || squared <= self.settings.min_double_area_squared
-            || (self.settings.world_may_underflow && cross_underflows(world_corners))
+        is_zero_area(&self.frame, &self.settings, world_corners)
     }
 
     /// Whether moving `a` and `b` to `world` would leave a surviving face of either

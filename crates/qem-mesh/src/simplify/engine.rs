@@ -69,31 +69,37 @@ fn place(
     if let Some(exact) = exact {
         q -= exact.edge(ab);
     }
-    let fixed = if sa.locked {
-        Some((a, PlacementRule::FirstEnd))
-    } else if sb.locked {
-        Some((b, PlacementRule::SecondEnd))
+    let ends = [(sa.position, sa.locked), (sb.position, sb.locked)];
+    (place_merged(&q, ends, placement), q)
+}
+
+/// Where the merged vertex of a pair goes, given the merged quadric `q` and each end's
+/// position and lock: a locked end stays put (the first, if both are), otherwise
+/// `placement` decides.
+pub(super) fn place_merged(
+    q: &Quadric,
+    [(pa, locked_a), (pb, locked_b)]: [(DVec3, bool); 2],
+    placement: PlacementMode,
+) -> Placement {
+    let fixed = if locked_a {
+        Some((pa, PlacementRule::FirstEnd))
+    } else if locked_b {
+        Some((pb, PlacementRule::SecondEnd))
     } else {
         None
     };
-    if let Some((v, rule)) = fixed {
-        let position = if v == a { sa.position } else { sb.position };
+    if let Some((position, rule)) = fixed {
         let cost = q.evaluate(position).max(0.0);
-        return (
-            Placement {
-                position,
-                cost,
-                rule,
-            },
-            q,
-        );
+        return Placement {
+            position,
+            cost,
+            rule,
+        };
     }
-    let (pa, pb) = (sa.position, sb.position);
-    let placed = match placement {
-        PlacementMode::Optimal => optimal_placement(&q, pa, pb),
-        PlacementMode::EndpointOrMidpoint => endpoint_placement(&q, pa, pb),
-    };
-    (placed, q)
+    match placement {
+        PlacementMode::Optimal => optimal_placement(q, pa, pb),
+        PlacementMode::EndpointOrMidpoint => endpoint_placement(q, pa, pb),
+    }
 }
 
 /// The position of `v` in normalised units: its loop state's, or the store's converted
@@ -253,7 +259,7 @@ pub(super) struct Counters {
 }
 
 impl Counters {
-    fn reject(&mut self, why: Rejection) {
+    pub(super) fn reject(&mut self, why: Rejection) {
         let counter = match why {
             Rejection::Degenerate => &mut self.rejected_degenerate,
             Rejection::Flip => &mut self.rejected_flip,
@@ -297,6 +303,30 @@ pub(super) struct Settings {
     pub any_locked: bool,
 }
 
+impl Settings {
+    /// The settings of `options` for a run in `frame`.
+    pub(super) fn new(options: &SimplifyOptions, frame: &Frame) -> Settings {
+        let max_error_bound = options
+            .max_error
+            .map_or(f64::INFINITY, |e| e.normalized(frame));
+        let angle = options.max_normal_angle.clamp(0.0, 180.0);
+        Settings {
+            placement: options.placement,
+            max_error_bound,
+            min_double_area_squared: min_double_area(frame.normalized_diagonal()).powi(2),
+            // A cross product of edges of length L is about L²; f64 underflows below
+            // ~1e-308, so only a model smaller than ~1e-150 can be affected.
+            world_may_underflow: frame.world_diagonal() < WORLD_UNDERFLOW_DIAGONAL,
+            min_normal_cos: (angle < 180.0).then(|| angle.to_radians().cos()),
+            min_quality: (options.min_triangle_quality > 0.0)
+                .then_some(options.min_triangle_quality),
+            preserve_topology: options.preserve_topology,
+            keep_border_loops: options.boundary != BoundaryMode::Free,
+            any_locked: false,
+        }
+    }
+}
+
 /// The state of one run of the contraction loop.
 pub(super) struct Engine {
     pub store: MeshStore,
@@ -334,24 +364,7 @@ pub(super) struct Engine {
 
 impl Engine {
     pub fn new(store: MeshStore, frame: Frame, options: &SimplifyOptions) -> Self {
-        let max_error_bound = options
-            .max_error
-            .map_or(f64::INFINITY, |e| e.normalized(&frame));
-        let angle = options.max_normal_angle.clamp(0.0, 180.0);
-        let settings = Settings {
-            placement: options.placement,
-            max_error_bound,
-            min_double_area_squared: min_double_area(frame.normalized_diagonal()).powi(2),
-            // A cross product of edges of length L is about L²; f64 underflows below
-            // ~1e-308, so only a model smaller than ~1e-150 can be affected.
-            world_may_underflow: frame.world_diagonal() < WORLD_UNDERFLOW_DIAGONAL,
-            min_normal_cos: (angle < 180.0).then(|| angle.to_radians().cos()),
-            min_quality: (options.min_triangle_quality > 0.0)
-                .then_some(options.min_triangle_quality),
-            preserve_topology: options.preserve_topology,
-            keep_border_loops: options.boundary != BoundaryMode::Free,
-            any_locked: false,
-        };
+        let settings = Settings::new(options, &frame);
         Engine {
             state: VertexStates::with_capacity(store.vertex_count()),
             queue: PairQueue::new(&store),

@@ -21,20 +21,22 @@ mod exact;
 mod observer;
 mod options;
 mod orientation;
+mod passes;
 mod report;
 
 pub use observer::{Contraction, NoObserver, Observer, Progress};
 pub use options::{
-    BoundaryMode, Length, PlacementMode, QuadricMode, SimplifyOptions, Target, VirtualPairs,
-    Weighting, DEFAULT_BOUNDARY_WEIGHT, DEFAULT_MAX_NORMAL_ANGLE, DEFAULT_MIN_TRIANGLE_QUALITY,
-    DEFAULT_WEIGHTING_MIX,
+    BoundaryMode, ContractionOrder, Length, PlacementMode, QuadricMode, SimplifyOptions, Target,
+    VirtualPairs, Weighting, DEFAULT_BOUNDARY_WEIGHT, DEFAULT_MAX_NORMAL_ANGLE,
+    DEFAULT_MIN_TRIANGLE_QUALITY, DEFAULT_WEIGHTING_MIX,
 };
 pub use report::{Simplified, SimplifyError, SimplifyReport, StopReason, Timings};
 
 use crate::clean::{clean, CleanOptions, Cleaned};
 use crate::store::MeshStore;
 use crate::IndexedMesh;
-use engine::Engine;
+use engine::{Counters, Engine};
+use passes::PassEngine;
 use qem_core::{DVec3, Frame};
 use std::time::Instant;
 
@@ -148,36 +150,27 @@ pub fn simplify_levels(
     }
     timings.clean = clock.elapsed();
 
-    let clock = Instant::now();
-    let (store, keys) = MeshStore::from_mesh(&cleaned.mesh)?;
-    timings.build = clock.elapsed();
-
     let frame = Frame::from_points(cleaned.mesh.positions.iter().map(|p| DVec3::from_array(*p)));
-    let mut engine = Engine::new(store, frame, options);
-    let clock = Instant::now();
-    // The orientation check's index is independent of the quadrics and queue: built on
-    // the other core meanwhile (deterministic either way).
-    let ((), input_surface) = rayon::join(
-        || engine.initialise(&cleaned.mesh, &keys, &locked, options),
-        || {
-            options
-                .orientation_check
-                .then(|| orientation::InputSurface::new(&cleaned.mesh, &frame))
-        },
-    );
-    // The store makes one face per cleaned triangle, in order, when none is refused;
-    // each face's search hint starts as its own triangle.
-    engine.input_surface = input_surface.map(|(mut surface, slots)| {
-        surface.seed_hints(engine.store.faces(), engine.store.face_count(), &slots);
-        surface
-    });
-    timings.setup = clock.elapsed();
+    let mut run = match options.order {
+        ContractionOrder::Greedy => Run::Greedy(set_up_greedy(
+            &cleaned,
+            frame,
+            &locked,
+            options,
+            &mut timings,
+        )?),
+        ContractionOrder::Passes => {
+            refuse_what_passes_lack(options, &frame)?;
+            let clock = Instant::now();
+            let engine = PassEngine::new(&cleaned.mesh, frame, &locked, options);
+            timings.setup = clock.elapsed();
+            Run::Passes(engine)
+        }
+    };
     observer.cleaned(&cleaned.mesh, &frame);
-    // The loop needs neither the cleaned mesh nor the keys of its vertices: gone before
-    // it starts (about 120 MB on a 4M-triangle mesh), since it runs far longer than
-    // the setup and holds the most.
+    // The loop needs the cleaned mesh no more: gone before it starts (about 120 MB on
+    // a 4M-triangle mesh), since it runs far longer than the setup and holds the most.
     drop(cleaned);
-    drop(keys);
 
     let mut results = Vec::with_capacity(levels.len());
     let mut stopped_short: Option<StopReason> = None;
@@ -186,7 +179,7 @@ pub fn simplify_levels(
         let clock = Instant::now();
         let stop_reason = match stopped_short {
             Some(reason) => reason,
-            None => engine.run(target_triangles, options, observer)?,
+            None => run.run(target_triangles, options, observer)?,
         };
         if stop_reason != StopReason::TargetReached {
             stopped_short = Some(stop_reason);
@@ -194,13 +187,13 @@ pub fn simplify_levels(
         timings.contract += clock.elapsed();
 
         let clock = Instant::now();
-        let mut raw = engine.store.to_mesh();
+        let mut raw = run.to_mesh();
         // Zero area is judged in the loop's frame, not in the output's own (see
         // `Engine::is_zero_area`): the loop refused every contraction that would make a
         // face zero-area, so this drops only faces that came in so (cleaning passes off).
         let before = raw.triangles.len();
         raw.triangles
-            .retain(|t| !engine.is_zero_area(t.map(|i| raw.positions[i as usize])));
+            .retain(|t| !run.is_zero_area(t.map(|i| raw.positions[i as usize])));
         let zero_area_dropped = before - raw.triangles.len();
         let final_clean = clean(&raw, &CleanOptions::OUTPUT.with_drop_zero_area(false));
         let out = final_clean.mesh;
@@ -211,7 +204,7 @@ pub fn simplify_levels(
         }
         timings.compact = clock.elapsed();
 
-        let counters = engine.counters;
+        let counters = run.counters();
         let report = SimplifyReport {
             triangles_in: mesh.triangle_count(),
             vertices_in: mesh.vertex_count(),
@@ -237,12 +230,121 @@ pub fn simplify_levels(
             rejected_merge: counters.rejected_merge,
             rejected_orientation: counters.rejected_orientation,
             locked_vertices: counters.locked_vertices,
-            faces_flipped: engine.flipped_faces(),
+            faces_flipped: run.flipped_faces(),
             timings,
         };
         results.push(Simplified { mesh: out, report });
     }
     Ok(results)
+}
+
+/// The greedy loop's store, quadrics, queue and (on the other core meanwhile) the
+/// orientation check's index.
+fn set_up_greedy(
+    cleaned: &Cleaned,
+    frame: Frame,
+    locked: &[u32],
+    options: &SimplifyOptions,
+    timings: &mut Timings,
+) -> Result<Engine, SimplifyError> {
+    let clock = Instant::now();
+    let (store, keys) = MeshStore::from_mesh(&cleaned.mesh)?;
+    timings.build = clock.elapsed();
+
+    let mut engine = Engine::new(store, frame, options);
+    let clock = Instant::now();
+    // The orientation check's index is independent of the quadrics and queue: built on
+    // the other core meanwhile (deterministic either way).
+    let ((), input_surface) = rayon::join(
+        || engine.initialise(&cleaned.mesh, &keys, locked, options),
+        || {
+            options
+                .orientation_check
+                .then(|| orientation::InputSurface::new(&cleaned.mesh, &frame))
+        },
+    );
+    // The store makes one face per cleaned triangle, in order, when none is refused;
+    // each face's search hint starts as its own triangle.
+    engine.input_surface = input_surface.map(|(mut surface, slots)| {
+        surface.seed_hints(engine.store.faces(), engine.store.face_count(), &slots);
+        surface
+    });
+    timings.setup = clock.elapsed();
+    Ok(engine)
+}
+
+/// [`SimplifyError::NotInPasses`] for the first option set that the pass-based order
+/// does not implement.
+fn refuse_what_passes_lack(options: &SimplifyOptions, frame: &Frame) -> Result<(), SimplifyError> {
+    let lacking = if options.quadrics == QuadricMode::Exact {
+        Some("quadrics = Exact")
+    } else if options.orientation_check {
+        Some("orientation_check = true")
+    } else if options.preserve_topology {
+        Some("preserve_topology = true")
+    } else if options.pair_threshold.normalized(frame) > 0.0 {
+        Some("pair_threshold above zero (virtual pairs)")
+    } else {
+        None
+    };
+    match lacking {
+        Some(option) => Err(SimplifyError::NotInPasses { option }),
+        None => Ok(()),
+    }
+}
+
+/// A run in either order, as the level loop of [`simplify_levels`] drives it.
+// One value per run, made once: the size of the larger variant costs nothing.
+#[allow(clippy::large_enum_variant)]
+enum Run {
+    Greedy(Engine),
+    Passes(PassEngine),
+}
+
+impl Run {
+    fn run(
+        &mut self,
+        target: usize,
+        options: &SimplifyOptions,
+        observer: &mut dyn Observer,
+    ) -> Result<StopReason, SimplifyError> {
+        match self {
+            Run::Greedy(engine) => engine.run(target, options, observer),
+            Run::Passes(engine) => Ok(engine.run(target, observer)),
+        }
+    }
+
+    fn to_mesh(&self) -> IndexedMesh {
+        match self {
+            Run::Greedy(engine) => engine.store.to_mesh(),
+            Run::Passes(engine) => engine.to_mesh(),
+        }
+    }
+
+    /// Whether the loop counts a face with these world corners as zero-area (see
+    /// `Engine::is_zero_area`).
+    fn is_zero_area(&self, world_corners: [[f64; 3]; 3]) -> bool {
+        match self {
+            Run::Greedy(engine) => engine.is_zero_area(world_corners),
+            Run::Passes(engine) => {
+                checks::is_zero_area(&engine.frame, &engine.settings, world_corners)
+            }
+        }
+    }
+
+    fn counters(&self) -> Counters {
+        match self {
+            Run::Greedy(engine) => engine.counters,
+            Run::Passes(engine) => engine.counters,
+        }
+    }
+
+    fn flipped_faces(&self) -> usize {
+        match self {
+            Run::Greedy(engine) => engine.flipped_faces(),
+            Run::Passes(engine) => engine.flipped_faces(),
+        }
+    }
 }
 
 /// The triangle count a target asks for, given the input's count as loaded.

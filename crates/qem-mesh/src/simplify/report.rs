@@ -159,6 +159,13 @@ pub enum SimplifyError {
         /// How many vertices the input has.
         vertex_count: usize,
     },
+    /// An option that [`ContractionOrder::Passes`](super::ContractionOrder::Passes)
+    /// does not implement was asked for with it.
+    NotInPasses {
+        /// The option, as the field of [`SimplifyOptions`](super::SimplifyOptions)
+        /// and its value (for example `"quadrics = Exact"`).
+        option: &'static str,
+    },
     /// A bug: the store broke an invariant (only detected with
     /// [`SimplifyOptions::validate_each_contraction`](super::SimplifyOptions::validate_each_contraction)).
     Internal(StoreError),
@@ -180,6 +187,11 @@ impl fmt::Display for SimplifyError {
                 f,
                 "locked vertex {index} is out of range: the input has {vertex_count} \
                  vertices (indices start at 0)"
+            ),
+            SimplifyError::NotInPasses { option } => write!(
+                f,
+                "{option} is not available in the pass-based order (ContractionOrder::Passes); \
+                 start from SimplifyOptions::FAST, or use the greedy order"
             ),
             SimplifyError::Internal(e) => write!(f, "internal error, please report: {e}"),
         }

@@ -1,0 +1,793 @@
+//! The pass-based contraction order ([`ContractionOrder::Passes`]): flat arrays instead
+//! of the store, and the cheapest pairs contracted in batches instead of one at a time.
+//!
+//! Each pass:
+//! 1. lists, for every vertex, the live triangles around it (one counting sort);
+//! 2. lists every edge once, and costs it (on both cores: each cost reads only its two
+//!    ends, so the results do not depend on the thread count);
+//! 3. takes the cheapest edges, at most as many as the contractions still needed, in
+//!    order of (cost, first vertex, second vertex), a total order, so the same input
+//!    gives the same order;
+//! 4. contracts them in that order, skipping an edge whose end already moved in this
+//!    pass (its cost is stale) or that fails the checks (fold-over, merged faces,
+//!    border loops, locks; the same rules as the greedy loop's), until the target;
+//! 5. renames the removed vertices in the triangles.
+//!
+//! Why it is faster than [`ContractionOrder::Greedy`]: no heap, no store to keep
+//! consistent, each edge costed once per pass rather than after every contraction
+//! near it, and the pass's reads are sequential. What it gives up: the strict greedy
+//! order (an edge whose cost fell below the batch's last one waits for the next pass),
+//! exact quadrics, virtual pairs, the orientation check and topology preservation
+//! (each refused with [`SimplifyError::NotInPasses`]).
+//!
+//! Why skipping an edge with a moved end is enough to keep the pass's view exact: a
+//! contraction of `b` into `a` changes only triangles around `b` (renamed to `a`) and
+//! around both (removed). A vertex `v` that did not move has the same triangles as at
+//! the pass's start, minus removed ones, and their corners are current once renamed
+//! through `remap`; both of `a` and `b` are then skipped for the rest of the pass, so
+//! the list of `a`'s triangles, which is now short of `b`'s, is never read.
+
+use super::checks::{quality, turned_past, Rejection};
+use super::engine::{place_merged, Counters, Settings};
+use super::observer::{Contraction, Observer, Progress};
+use super::options::{BoundaryMode, SimplifyOptions};
+use super::report::StopReason;
+use crate::clean::cross_underflows;
+use crate::IndexedMesh;
+use qem_core::{unit_normal_and_area, DVec3, Frame, Placement, Quadric, WeightedPlane};
+use rayon::prelude::*;
+use std::cmp::Ordering;
+
+/// How often (in contractions) the observer's progress is called.
+const OBSERVER_INTERVAL: usize = 4096;
+
+/// Marks a removed triangle in [`PassEngine::triangles`].
+const REMOVED: u32 = u32::MAX;
+
+/// An edge of the current pass and its cost (normalised units).
+#[derive(Clone, Copy, Debug)]
+struct Candidate {
+    a: u32,
+    b: u32,
+    cost: f64,
+}
+
+/// The order the candidates are taken in: cost, then the ends. A total order on
+/// distinct edges (NaN costs are stored as +∞, see [`PassEngine::cost_edges`]).
+fn cheaper(x: &Candidate, y: &Candidate) -> Ordering {
+    x.cost
+        .total_cmp(&y.cost)
+        .then(x.a.cmp(&y.a))
+        .then(x.b.cmp(&y.b))
+}
+
+/// A live triangle around a vertex: its index and its current corners.
+#[derive(Clone, Copy, Debug)]
+struct Around {
+    triangle: u32,
+    corners: [u32; 3],
+}
+
+/// Whether the pass ended for a reason that ends the run.
+enum PassEnd {
+    /// Ran out of candidates (or reached the target); `contracted` in this pass.
+    Done { contracted: usize },
+    /// The next candidate's error was above the bound.
+    MaxErrorReached,
+    /// The observer asked to stop.
+    Cancelled,
+}
+
+/// The state of one pass-based run.
+pub(super) struct PassEngine {
+    pub frame: Frame,
+    pub settings: Settings,
+    pub counters: Counters,
+    /// World positions: a vertex that never moves keeps its input bits.
+    world: Vec<[f64; 3]>,
+    /// Positions in the normalised frame.
+    position: Vec<DVec3>,
+    quadric: Vec<Quadric>,
+    locked: Vec<bool>,
+    /// Corners of every cleaned input triangle; [`REMOVED`] in the first corner once
+    /// the triangle is gone.
+    triangles: Vec<[u32; 3]>,
+    /// The indices of the live triangles, in increasing order.
+    live: Vec<u32>,
+    /// Each input triangle's (unnormalised) normal in the normalised frame.
+    original_normals: Vec<DVec3>,
+    /// `remap[v]` is what `v` became in this pass (itself, unless it was removed).
+    remap: Vec<u32>,
+    /// The pass in which each vertex last moved or was removed.
+    moved_in: Vec<u32>,
+    pass: u32,
+    /// The live triangles around each vertex: `incident[first[v]..first[v + 1]]`.
+    first: Vec<u32>,
+    incident: Vec<u32>,
+    candidates: Vec<Candidate>,
+    /// Where each vertex's edges (as the smaller end) start in `candidates`, as listed.
+    listed_first: Vec<u32>,
+    /// The last pass's edges and costs in listing order, and where each vertex's start.
+    last_listed: Vec<Candidate>,
+    last_listed_first: Vec<u32>,
+    /// Per vertex, the last vertex whose edges were listed with it (edge listing).
+    seen_with: Vec<u32>,
+    around: [Vec<Around>; 2],
+    since_report: usize,
+}
+
+impl PassEngine {
+    /// Face quadrics summed into vertex quadrics, border planes or locks, locked
+    /// vertices; `locked` lists cleaned-mesh indices.
+    pub fn new(
+        cleaned: &IndexedMesh,
+        frame: Frame,
+        locked: &[u32],
+        options: &SimplifyOptions,
+    ) -> Self {
+        let n = cleaned.positions.len();
+        let position: Vec<DVec3> = cleaned
+            .positions
+            .par_iter()
+            .map(|p| frame.to_normalized(DVec3::from_array(*p)))
+            .collect();
+        let mut engine = PassEngine {
+            settings: Settings::new(options, &frame),
+            frame,
+            counters: Counters::default(),
+            world: cleaned.positions.clone(),
+            quadric: vec![Quadric::default(); n],
+            locked: vec![false; n],
+            triangles: cleaned.triangles.clone(),
+            live: (0..cleaned.triangles.len() as u32).collect(),
+            original_normals: Vec::new(),
+            remap: (0..n as u32).collect(),
+            moved_in: vec![0; n],
+            pass: 0,
+            first: Vec::new(),
+            incident: Vec::new(),
+            candidates: Vec::new(),
+            listed_first: Vec::new(),
+            last_listed: Vec::new(),
+            last_listed_first: Vec::new(),
+            seen_with: vec![u32::MAX; n],
+            around: [Vec::new(), Vec::new()],
+            since_report: 0,
+            position,
+        };
+        let area_offset = engine.sum_face_planes(options);
+        engine.list_incident_triangles();
+        engine.initialise_boundary(options, area_offset);
+        for &i in locked {
+            if let Some(l) = engine.locked.get_mut(i as usize) {
+                *l = true;
+            }
+        }
+        engine.counters.locked_vertices = engine.locked.iter().filter(|&&l| l).count();
+        engine.settings.any_locked = engine.counters.locked_vertices > 0;
+        engine
+    }
+
+    /// The corners of triangle `t` in the normalised frame.
+    fn corners(&self, t: [u32; 3]) -> [DVec3; 3] {
+        t.map(|c| self.position[c as usize])
+    }
+
+    /// Each face's normal and plane (computed on both cores), summed into its vertices
+    /// in triangle order, so the sums' bits do not depend on the thread count. Returns
+    /// the weighting's constant added to face areas (`None`: unit weights).
+    fn sum_face_planes(&mut self, options: &SimplifyOptions) -> Option<f64> {
+        let areas: f64 = self
+            .triangles
+            .iter()
+            .map(|&t| {
+                let [a, b, c] = self.corners(t);
+                unit_normal_and_area(a, b, c).map_or(0.0, |(_, area)| area)
+            })
+            .sum();
+        let mean_area = if self.triangles.is_empty() {
+            0.0
+        } else {
+            areas / self.triangles.len() as f64
+        };
+        let area_offset = options.weighting.area_offset(mean_area);
+        let planes: Vec<(DVec3, Quadric)> = self
+            .triangles
+            .par_iter()
+            .map(|&t| {
+                let [pa, pb, pc] = t.map(|c| self.position[c as usize]);
+                let plane = match area_offset {
+                    Some(extra) => WeightedPlane::from_triangle_area_plus(pa, pb, pc, extra),
+                    None => WeightedPlane::from_triangle_unweighted(pa, pb, pc),
+                };
+                ((pb - pa).cross(pc - pa), plane.quadric())
+            })
+            .collect();
+        self.original_normals = Vec::with_capacity(planes.len());
+        for (&t, &(normal, q)) in self.triangles.iter().zip(&planes) {
+            self.original_normals.push(normal);
+            for c in t {
+                self.quadric[c as usize] += q;
+            }
+        }
+        area_offset
+    }
+}
+
+impl PassEngine {
+    /// Lists the live triangles around every vertex, each vertex's in increasing
+    /// triangle order (a counting sort of the live triangles' corners).
+    fn list_incident_triangles(&mut self) {
+        let n = self.position.len();
+        self.first.clear();
+        self.first.resize(n + 1, 0);
+        for &t in &self.live {
+            for c in self.triangles[t as usize] {
+                self.first[c as usize + 1] += 1;
+            }
+        }
+        for v in 0..n {
+            self.first[v + 1] += self.first[v];
+        }
+        self.incident.clear();
+        self.incident.resize(self.live.len() * 3, 0);
+        // `seen_with` doubles as the fill cursor here; `list_edges` resets it.
+        self.seen_with.clear();
+        self.seen_with.extend_from_slice(&self.first[..n]);
+        for &t in &self.live {
+            for c in self.triangles[t as usize] {
+                let slot = &mut self.seen_with[c as usize];
+                self.incident[*slot as usize] = t;
+                *slot += 1;
+            }
+        }
+    }
+
+    /// The live triangles around `v`, with their current corners, into `out`.
+    fn gather(&self, v: u32, out: &mut Vec<Around>) {
+        out.clear();
+        let range = self.first[v as usize] as usize..self.first[v as usize + 1] as usize;
+        for &t in &self.incident[range] {
+            let corners = self.triangles[t as usize];
+            if corners[0] != REMOVED {
+                out.push(Around {
+                    triangle: t,
+                    corners: corners.map(|c| self.remap[c as usize]),
+                });
+            }
+        }
+    }
+
+    /// Border planes ([`BoundaryMode::Planes`]) or border locks ([`BoundaryMode::Locked`]),
+    /// as the greedy loop adds them: a border edge is an edge of exactly one triangle.
+    fn initialise_boundary(&mut self, options: &SimplifyOptions, area_offset: Option<f64>) {
+        let weight = match options.boundary {
+            BoundaryMode::Free => return,
+            BoundaryMode::Planes(w) if w > 0.0 && w.is_finite() => Some(w),
+            BoundaryMode::Planes(_) => return,
+            BoundaryMode::Locked => None,
+        };
+        let mut around = Vec::new();
+        for v in 0..self.position.len() as u32 {
+            self.gather(v, &mut around);
+            for (x, t) in border_neighbours(v, &around) {
+                if x < v {
+                    continue; // each border edge once, from its smaller end
+                }
+                let Some(w) = weight else {
+                    self.locked[v as usize] = true;
+                    self.locked[x as usize] = true;
+                    continue;
+                };
+                let [p0, p1, p2] = self.corners(self.triangles[t as usize]);
+                let normal = (p1 - p0).cross(p2 - p0).normalize_or_zero();
+                let (pa, pb) = (self.position[v as usize], self.position[x as usize]);
+                let plane_weight = match area_offset {
+                    Some(extra) => w * (pa.distance_squared(pb) + extra),
+                    None => w,
+                };
+                let q = Quadric::boundary_constraint(pa, pb, normal, plane_weight);
+                self.quadric[v as usize] += q;
+                self.quadric[x as usize] += q;
+            }
+        }
+    }
+
+    /// Contracts until `target` triangles are left, the error bound, no contraction
+    /// is possible, or the observer stops it.
+    pub fn run(&mut self, target: usize, observer: &mut dyn Observer) -> StopReason {
+        let start = self.live.len();
+        let reason = loop {
+            if self.live.len() <= target {
+                break StopReason::TargetReached;
+            }
+            match self.pass(target, start, observer) {
+                PassEnd::Done { contracted: 0 } => break StopReason::NoValidPair,
+                PassEnd::Done { .. } => {}
+                PassEnd::MaxErrorReached => break StopReason::MaxErrorReached,
+                PassEnd::Cancelled => break StopReason::Cancelled,
+            }
+        };
+        observer.progress(Progress {
+            triangles: self.live.len(),
+            triangles_start: start,
+            target,
+        });
+        reason
+    }
+
+    /// One pass (see the module's doc). `start` is the run's triangle count, for
+    /// progress.
+    fn pass(&mut self, target: usize, start: usize, observer: &mut dyn Observer) -> PassEnd {
+        self.pass += 1;
+        if self.pass > 1 {
+            self.list_incident_triangles();
+        }
+        self.list_edges();
+        self.cost_edges();
+        // Each contraction of an interior edge removes two triangles: more candidates
+        // than that would only be skipped, and fewer keep the batch closer to the
+        // greedy order.
+        let needed = self.live.len() - target;
+        let mut batch = std::mem::take(&mut self.candidates);
+        let mut take = needed.div_ceil(2).clamp(1, batch.len().max(1));
+        let mut from = 0;
+        let mut live_count = self.live.len();
+        let mut contracted = 0;
+        let mut end = None;
+        // The cheapest `take`, in order; if every one of them is refused (or stale),
+        // the next cheapest, four times as many, and so on: costs have not changed
+        // while nothing was contracted.
+        while from < batch.len() {
+            if take < batch.len() {
+                batch[from..].select_nth_unstable_by(take - from - 1, cheaper);
+            }
+            batch[from..take].sort_unstable_by(cheaper);
+            for &Candidate { a, b, .. } in &batch[from..take] {
+                if live_count <= target {
+                    break;
+                }
+                if self.moved_in[a as usize] == self.pass || self.moved_in[b as usize] == self.pass
+                {
+                    continue; // a stale cost: asked again next pass
+                }
+                match self.try_contract(a, b, live_count, observer) {
+                    Attempt::Contracted { removed } => {
+                        live_count -= removed;
+                        contracted += 1;
+                    }
+                    Attempt::Refused => {}
+                    Attempt::OverErrorBound => {
+                        end = Some(PassEnd::MaxErrorReached);
+                        break;
+                    }
+                }
+                self.since_report += 1;
+                if self.since_report >= OBSERVER_INTERVAL {
+                    self.since_report = 0;
+                    observer.progress(Progress {
+                        triangles: live_count,
+                        triangles_start: start,
+                        target,
+                    });
+                    if observer.should_stop() {
+                        end = Some(PassEnd::Cancelled);
+                        break;
+                    }
+                }
+            }
+            if contracted > 0 || end.is_some() {
+                break;
+            }
+            from = take;
+            take = take.saturating_mul(4).min(batch.len());
+        }
+        self.candidates = batch;
+        self.rename_removed();
+        end.unwrap_or(PassEnd::Done { contracted })
+    }
+
+    /// Lists every edge of the live triangles once, as (smaller end, larger end), in
+    /// order of the smaller end.
+    fn list_edges(&mut self) {
+        self.seen_with.fill(u32::MAX);
+        self.candidates.clear();
+        self.listed_first.clear();
+        for v in 0..self.position.len() as u32 {
+            self.listed_first.push(self.candidates.len() as u32);
+            let range = self.first[v as usize] as usize..self.first[v as usize + 1] as usize;
+            for &t in &self.incident[range] {
+                for c in self.triangles[t as usize] {
+                    if c > v && self.seen_with[c as usize] != v {
+                        self.seen_with[c as usize] = v;
+                        self.candidates.push(Candidate {
+                            a: v,
+                            b: c,
+                            cost: 0.0,
+                        });
+                    }
+                }
+            }
+        }
+        self.listed_first.push(self.candidates.len() as u32);
+    }
+
+    /// Costs every candidate, on both cores (each cost reads only its two ends). A NaN
+    /// cost (only from overflow) is stored as +∞, so that it comes last.
+    ///
+    /// An edge whose ends did not move in the last pass existed then (a new edge
+    /// always has a moved end) and has the same quadrics and positions, so its cost is
+    /// taken from the last pass's list instead of solved again: the same value, bit
+    /// for bit. Late passes re-cost only a few percent of their edges this way.
+    fn cost_edges(&mut self) {
+        let this = &*self;
+        let costs: Vec<f64> = this
+            .candidates
+            .par_iter()
+            .map(|c| {
+                if let Some(cost) = this.last_cost(c.a, c.b) {
+                    return cost;
+                }
+                let (placed, _) = this.place(c.a, c.b);
+                if placed.cost.is_nan() {
+                    f64::INFINITY
+                } else {
+                    placed.cost
+                }
+            })
+            .collect();
+        for (c, cost) in self.candidates.iter_mut().zip(costs) {
+            c.cost = cost;
+        }
+        self.last_listed.clone_from(&self.candidates);
+        std::mem::swap(&mut self.last_listed_first, &mut self.listed_first);
+    }
+
+    /// The cost of the edge `a b` (`a < b`) in the last pass's list, when neither end
+    /// moved in that pass.
+    fn last_cost(&self, a: u32, b: u32) -> Option<f64> {
+        let last = self.pass.checked_sub(1).filter(|&p| p > 0)?;
+        if self.moved_in[a as usize] == last || self.moved_in[b as usize] == last {
+            return None;
+        }
+        let range = self.last_listed_first[a as usize] as usize
+            ..self.last_listed_first[a as usize + 1] as usize;
+        self.last_listed[range]
+            .iter()
+            .find(|c| c.b == b)
+            .map(|c| c.cost)
+    }
+
+    /// The merged quadric of `a` and `b`, where the new vertex would go and its cost;
+    /// a locked end stays put.
+    fn place(&self, a: u32, b: u32) -> (Placement, Quadric) {
+        let (a, b) = (a as usize, b as usize);
+        let q = self.quadric[a] + self.quadric[b];
+        let ends = [
+            (self.position[a], self.locked[a]),
+            (self.position[b], self.locked[b]),
+        ];
+        (place_merged(&q, ends, self.settings.placement), q)
+    }
+
+    /// Checks and contracts the edge `a b` (both unmoved in this pass); `live` is the
+    /// live triangle count.
+    fn try_contract(
+        &mut self,
+        mut a: u32,
+        mut b: u32,
+        live: usize,
+        observer: &mut dyn Observer,
+    ) -> Attempt {
+        let (locked_a, locked_b) = (self.locked[a as usize], self.locked[b as usize]);
+        if locked_a && locked_b {
+            self.counters.reject(Rejection::Locked);
+            return Attempt::Refused;
+        }
+        if locked_b {
+            std::mem::swap(&mut a, &mut b); // the locked vertex is the one that stays
+        }
+        let mut around = std::mem::take(&mut self.around);
+        self.gather(a, &mut around[0]);
+        self.gather(b, &mut around[1]);
+        let shared = around[0].iter().filter(|x| x.corners.contains(&b)).count();
+        // Never contract the last faces away: the output must keep a triangle.
+        let attempt = if shared >= live {
+            Attempt::Refused
+        } else {
+            self.check_and_contract(a, b, locked_a || locked_b, shared, &around, observer)
+        };
+        self.around = around;
+        attempt
+    }
+
+    /// [`try_contract`](Self::try_contract) with `around` = the live triangles of `a`
+    /// and of `b`, `shared` of which are on both.
+    fn check_and_contract(
+        &mut self,
+        a: u32,
+        b: u32,
+        any_locked: bool,
+        shared: usize,
+        around: &[Vec<Around>; 2],
+        observer: &mut dyn Observer,
+    ) -> Attempt {
+        let (placed, q) = self.place(a, b);
+        let error = q.rms_distance(placed.cost);
+        if error > self.settings.max_error_bound {
+            return Attempt::OverErrorBound;
+        }
+        let world = if any_locked {
+            // Bit for bit where it was, not a round trip through the frame.
+            DVec3::from_array(self.world[a as usize])
+        } else {
+            let world = self.frame.to_world(placed.position);
+            if world.is_finite() {
+                world
+            } else {
+                DVec3::from_array(self.world[a as usize])
+            }
+        };
+        if let Err(why) = self.check(a, b, world, shared, around) {
+            self.counters.reject(why);
+            return Attempt::Refused;
+        }
+        // The contraction itself.
+        self.remap[b as usize] = a;
+        self.moved_in[a as usize] = self.pass;
+        self.moved_in[b as usize] = self.pass;
+        self.position[a as usize] = self.frame.to_normalized(world);
+        self.world[a as usize] = world.to_array();
+        self.quadric[a as usize] = q;
+        let mut removed = 0;
+        for x in around[0].iter().filter(|x| x.corners.contains(&b)) {
+            self.triangles[x.triangle as usize][0] = REMOVED;
+            removed += 1;
+        }
+        self.counters.edge_contractions += 1;
+        self.counters.max_error = self.counters.max_error.max(error);
+        observer.contracted(&Contraction {
+            kept: a,
+            removed: b,
+            is_virtual: false,
+            quadric: q,
+            position: placed.position,
+            cost: placed.cost,
+        });
+        Attempt::Contracted { removed }
+    }
+
+    /// Every check of contracting `b` into `a` at `world`, the greedy loop's rules on
+    /// the pass's arrays: fold-over (degenerate, flipped, sliver), merged faces, border
+    /// loops, locks.
+    fn check(
+        &self,
+        a: u32,
+        b: u32,
+        world: DVec3,
+        shared: usize,
+        around: &[Vec<Around>; 2],
+    ) -> Result<(), Rejection> {
+        self.fold_over(a, b, world, around)?;
+        if would_merge_faces(a, b, around) {
+            return Err(Rejection::Merge);
+        }
+        if self.settings.keep_border_loops && !keeps_border_loops(a, b, shared, around) {
+            return Err(Rejection::Border);
+        }
+        if self.settings.any_locked && self.locked_vertex_would_vanish(a, b, around) {
+            return Err(Rejection::Locked);
+        }
+        Ok(())
+    }
+
+    /// The greedy loop's fold-over check (see `Engine::fold_over`) on `around`.
+    fn fold_over(
+        &self,
+        a: u32,
+        b: u32,
+        world: DVec3,
+        around: &[Vec<Around>; 2],
+    ) -> Result<(), Rejection> {
+        let moved = self.frame.to_normalized(world);
+        for x in around.iter().flatten() {
+            let corners = x.corners;
+            if corners.contains(&a) && corners.contains(&b) {
+                continue; // collapses with the pair
+            }
+            let old = self.corners(corners);
+            let new = std::array::from_fn::<_, 3, _>(|i| {
+                if corners[i] == a || corners[i] == b {
+                    moved
+                } else {
+                    old[i]
+                }
+            });
+            let new_normal = (new[1] - new[0]).cross(new[2] - new[0]);
+            let new_squared = new_normal.length_squared();
+            if new_squared.is_nan()
+                || new_squared <= self.settings.min_double_area_squared
+                || (self.settings.world_may_underflow
+                    && cross_underflows(corners.map(|c| {
+                        if c == a || c == b {
+                            world.to_array()
+                        } else {
+                            self.world[c as usize]
+                        }
+                    })))
+            {
+                return Err(Rejection::Degenerate);
+            }
+            let old_normal = (old[1] - old[0]).cross(old[2] - old[0]);
+            if let Some(min_cos) = self.settings.min_normal_cos {
+                let input_normal = self.original_normals[x.triangle as usize];
+                if turned_past(old_normal, new_normal, new_squared, min_cos)
+                    || input_normal.dot(new_normal) < 0.0
+                {
+                    return Err(Rejection::Flip);
+                }
+            }
+            if let Some(min_quality) = self.settings.min_quality {
+                let q_new = quality(new[0], new[1], new[2], new_squared.sqrt());
+                if q_new < min_quality
+                    && q_new < quality(old[0], old[1], old[2], old_normal.length())
+                {
+                    return Err(Rejection::Sliver);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether contracting `b` into `a` would leave a locked vertex without a triangle:
+    /// `a` itself, or a locked common neighbour whose triangles all collapse or merge.
+    /// A neighbour that moved in this pass may list too few triangles, which can only
+    /// make this refuse.
+    fn locked_vertex_would_vanish(&self, a: u32, b: u32, around: &[Vec<Around>; 2]) -> bool {
+        if self.locked[a as usize] {
+            let left = around[0]
+                .iter()
+                .chain(&around[1])
+                .filter(|x| !(x.corners.contains(&a) && x.corners.contains(&b)))
+                .count();
+            if left == 0 {
+                return true;
+            }
+        }
+        let mut of_w = Vec::new();
+        for x in &around[0] {
+            for w in x.corners {
+                if w == a || w == b || !self.locked[w as usize] {
+                    continue;
+                }
+                if !around[1].iter().any(|y| y.corners.contains(&w)) {
+                    continue; // not a common neighbour
+                }
+                self.gather(w, &mut of_w);
+                let left = of_w
+                    .iter()
+                    .filter(|y| {
+                        let (has_a, has_b) = (y.corners.contains(&a), y.corners.contains(&b));
+                        if has_a && has_b {
+                            return false;
+                        }
+                        if has_b {
+                            // w b z merges into w a z when that exists.
+                            let z = y.corners.into_iter().find(|&v| v != w && v != b);
+                            return z.is_none_or(|z| {
+                                !of_w
+                                    .iter()
+                                    .any(|u| u.corners.contains(&a) && u.corners.contains(&z))
+                            });
+                        }
+                        true
+                    })
+                    .count();
+                if left == 0 {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+
+    /// Takes the removed triangles off the live list and renames the removed vertices
+    /// in the others, ending the pass.
+    fn rename_removed(&mut self) {
+        let triangles = &mut self.triangles;
+        let remap = &self.remap;
+        self.live.retain(|&t| {
+            let corners = &mut triangles[t as usize];
+            if corners[0] == REMOVED {
+                return false;
+            }
+            *corners = corners.map(|c| remap[c as usize]);
+            true
+        });
+    }
+
+    /// The live triangles with every vertex in model units (unreferenced vertices
+    /// included; the caller's cleaning drops them).
+    pub fn to_mesh(&self) -> IndexedMesh {
+        IndexedMesh {
+            positions: self.world.clone(),
+            triangles: self
+                .live
+                .iter()
+                .map(|&t| self.triangles[t as usize])
+                .collect(),
+        }
+    }
+
+    /// Live triangles whose normal points more than 90° away from the input triangle's.
+    pub fn flipped_faces(&self) -> usize {
+        self.live
+            .iter()
+            .filter(|&&t| {
+                let [p0, p1, p2] = self.corners(self.triangles[t as usize]);
+                (p1 - p0)
+                    .cross(p2 - p0)
+                    .dot(self.original_normals[t as usize])
+                    < 0.0
+            })
+            .count()
+    }
+}
+
+/// What [`PassEngine::try_contract`] did.
+enum Attempt {
+    /// Contracted, removing this many triangles.
+    Contracted { removed: usize },
+    /// Refused by a check (counted) or to keep the last triangles.
+    Refused,
+    /// The pair's error is above the bound.
+    OverErrorBound,
+}
+
+/// The neighbours `x` of `v` joined to it by a border edge (exactly one triangle of
+/// `around`, the triangles of `v`, holds both), each with that triangle, in order of
+/// first appearance.
+fn border_neighbours(v: u32, around: &[Around]) -> impl Iterator<Item = (u32, u32)> + '_ {
+    around.iter().enumerate().flat_map(move |(i, x)| {
+        x.corners.into_iter().filter_map(move |c| {
+            if c == v || around[..i].iter().any(|y| y.corners.contains(&c)) {
+                return None; // v itself, or seen in an earlier triangle
+            }
+            let alone = !around[i + 1..].iter().any(|y| y.corners.contains(&c));
+            alone.then_some((c, x.triangle))
+        })
+    })
+}
+
+/// Whether contracting the edge `a b` would merge a triangle `a x y` with a triangle
+/// `b x y` (see `Engine::would_merge_faces`).
+fn would_merge_faces(a: u32, b: u32, around: &[Vec<Around>; 2]) -> bool {
+    around[1].iter().any(|y| {
+        if y.corners.contains(&a) {
+            return false; // collapses with the pair
+        }
+        let mut others = y.corners.into_iter().filter(|&c| c != b);
+        match (others.next(), others.next()) {
+            (Some(p), Some(q)) => around[0]
+                .iter()
+                .any(|x| x.corners.contains(&p) && x.corners.contains(&q)),
+            _ => false,
+        }
+    })
+}
+
+/// Whether contracting the edge `a b` (held by `shared` triangles) keeps every border
+/// loop (see `Engine::keeps_border_loops`): when both ends are on a border, `a b` must
+/// be a border edge, and no third vertex may be joined to both by border edges.
+fn keeps_border_loops(a: u32, b: u32, shared: usize, around: &[Vec<Around>; 2]) -> bool {
+    let mut a_border = border_neighbours(a, &around[0]).peekable();
+    let mut b_border = border_neighbours(b, &around[1]).peekable();
+    if a_border.peek().is_none() || b_border.peek().is_none() {
+        return true;
+    }
+    if shared != 1 {
+        return false;
+    }
+    let b_border: Vec<u32> = b_border.map(|(x, _)| x).collect();
+    !a_border.any(|(x, _)| x != b && b_border.contains(&x))
+}
