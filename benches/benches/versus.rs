@@ -9,6 +9,8 @@
 //! - qem: `qem_mesh::simplify::simplify` with `SimplifyOptions::DEFAULT` (t = 0,
 //!   optimal placement, area weighting) and `Target::Triangles(target)`. The timed call
 //!   is the whole library call: validation, cleaning, store, quadrics, loop, compaction.
+//!   With `--fast`, `SimplifyOptions::FAST` instead (the pass-based order, summed
+//!   quadrics, no orientation check), reported as `qem --fast`.
 //! - meshopt: `meshopt::simplify` (meshoptimizer's `meshopt_simplify`, vendored by the
 //!   `meshopt` crate) on `f32` positions, with the target index count, no options and
 //!   a target error of `f32::MAX`, so that it stops on the count alone. Only the call is
@@ -77,10 +79,13 @@ struct Args {
     ratios: Vec<f64>,
     runs: usize,
     tools: Tools,
+    /// qem runs with `SimplifyOptions::FAST` (the pass-based order) instead of
+    /// `DEFAULT`.
+    fast: bool,
 }
 
 const USAGE: &str = "usage: versus [--input dragon|soup|sphere:N|PATH]... [--ratios R,R...] \
-                     [--runs K] [--tool both|qem|meshopt|none|prep]";
+                     [--runs K] [--tool both|qem|meshopt|none|prep] [--fast]";
 
 fn parse_args() -> Result<Args, String> {
     let mut args = Args {
@@ -88,6 +93,7 @@ fn parse_args() -> Result<Args, String> {
         ratios: Vec::new(),
         runs: 5,
         tools: Tools::Both,
+        fast: false,
     };
     let mut it = std::env::args().skip(1);
     while let Some(flag) = it.next() {
@@ -122,6 +128,7 @@ fn parse_args() -> Result<Args, String> {
                     other => return Err(format!("unknown tool {other:?}\n{USAGE}")),
                 }
             }
+            "--fast" => args.fast = true,
             "-h" | "--help" => return Err(USAGE.to_string()),
             other => return Err(format!("unknown argument {other:?}\n{USAGE}")),
         }
@@ -293,8 +300,13 @@ fn medians(wall: &mut [f64], cpu: &mut [Option<f64>]) -> (f64, Option<f64>) {
     (median(wall), cpu.as_deref_mut().map(median))
 }
 
-fn run_qem(mesh: &IndexedMesh, target: usize, runs: usize) -> Result<Measured, String> {
-    let options = SimplifyOptions::DEFAULT.with_target(Target::Triangles(target));
+fn run_qem(mesh: &IndexedMesh, target: usize, runs: usize, fast: bool) -> Result<Measured, String> {
+    let base = if fast {
+        SimplifyOptions::FAST
+    } else {
+        SimplifyOptions::DEFAULT
+    };
+    let options = base.with_target(Target::Triangles(target));
     let (mut times, mut cpu_times) = (Vec::with_capacity(runs), Vec::with_capacity(runs));
     let mut triangles_out = 0;
     for run in 0..runs {
@@ -414,7 +426,7 @@ fn run() -> Result<(), String> {
         for &ratio in &args.ratios {
             let target = (ratio * n as f64).floor() as usize;
             let qem = if args.tools.qem() {
-                Some(run_qem(&welded, target, args.runs)?)
+                Some(run_qem(&welded, target, args.runs, args.fast)?)
             } else {
                 None
             };
@@ -423,10 +435,11 @@ fn run() -> Result<(), String> {
             } else {
                 None
             };
-            for (tool, m) in [("qem", &qem), ("meshopt", &meshopt)] {
+            let qem_name = if args.fast { "qem --fast" } else { "qem" };
+            for (tool, m) in [(qem_name, &qem), ("meshopt", &meshopt)] {
                 let Some(m) = m else { continue };
                 let (versus, versus_cpu) = match (tool, &meshopt) {
-                    ("qem", Some(o)) => (
+                    (name, Some(o)) if name == qem_name => (
                         format!("{:.2}", m.seconds / o.seconds),
                         m.cpu_seconds
                             .zip(o.cpu_seconds)

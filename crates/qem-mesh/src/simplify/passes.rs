@@ -4,28 +4,30 @@
 //! Each pass:
 //! 1. lists, for every vertex, the live triangles around it (one counting sort);
 //! 2. lists every edge once, and costs it (on both cores: each cost reads only its two
-//!    ends, so the results do not depend on the thread count);
-//! 3. takes the cheapest edges, at most as many as the contractions still needed, in
-//!    order of (cost, first vertex, second vertex), a total order, so the same input
-//!    gives the same order;
-//! 4. contracts them in that order, skipping an edge whose end already moved in this
-//!    pass (its cost is stale) or that fails the checks (fold-over, merged faces,
-//!    border loops, locks; the same rules as the greedy loop's), until the target;
-//! 5. renames the removed vertices in the triangles.
+//!    ends, so the results do not depend on the thread count; an edge whose ends did
+//!    not move in the last pass keeps its cost);
+//! 3. makes a batch of the cheapest edges, as many as the contractions still needed,
+//!    by (cost, index in the list), a total order;
+//! 4. contracts in rounds: each round takes the batch's *local minima*, the edges
+//!    that are the batch's cheapest at both of their ends (so no two share a vertex),
+//!    in list order (by first vertex, so the arrays are walked in order; the cheapest
+//!    first when the round may reach the target), each checked like the greedy loop's
+//!    pairs (fold-over, merged faces, border loops, locks); then the attempted edges
+//!    and every edge at a moved vertex leave the batch, and the next round starts,
+//!    until the batch is empty or the target is reached.
 //!
-//! Why it is faster than [`ContractionOrder::Greedy`]: no heap, no store to keep
-//! consistent, each edge costed once per pass rather than after every contraction
-//! near it, and the pass's reads are sequential. What it gives up: the strict greedy
-//! order (an edge whose cost fell below the batch's last one waits for the next pass),
-//! exact quadrics, virtual pairs, the orientation check and topology preservation
-//! (each refused with [`SimplifyError::NotInPasses`]).
+//! Why it is faster than [`ContractionOrder::Greedy`]: no heap and no store to keep
+//! consistent, each edge costed at most once per pass, and the contractions walk the
+//! arrays in order. What it gives up: the strict greedy order (an edge whose cost fell
+//! during a pass waits for the next one), exact quadrics, virtual pairs, the
+//! orientation check and topology preservation (each refused with
+//! [`SimplifyError::NotInPasses`]).
 //!
-//! Why skipping an edge with a moved end is enough to keep the pass's view exact: a
-//! contraction of `b` into `a` changes only triangles around `b` (renamed to `a`) and
-//! around both (removed). A vertex `v` that did not move has the same triangles as at
-//! the pass's start, minus removed ones, and their corners are current once renamed
-//! through `remap`; both of `a` and `b` are then skipped for the rest of the pass, so
-//! the list of `a`'s triangles, which is now short of `b`'s, is never read.
+//! Why the pass's view stays exact: a contraction of `b` into `a` changes only the
+//! triangles around `b` (renamed to `a` at once) and those around both (removed).
+//! Every edge at `a` or `b` then leaves the batch, so the list of `a`'s triangles,
+//! which is now short of `b`'s, is not read again in the pass; every other vertex has
+//! the triangles it had at the pass's start, minus the removed ones.
 
 use super::checks::{quality, turned_past, Rejection};
 use super::engine::{place_merged, Counters, Settings};
@@ -52,13 +54,11 @@ struct Candidate {
     cost: f64,
 }
 
-/// The order the candidates are taken in: cost, then the ends. A total order on
-/// distinct edges (NaN costs are stored as +∞, see [`PassEngine::cost_edges`]).
-fn cheaper(x: &Candidate, y: &Candidate) -> Ordering {
-    x.cost
-        .total_cmp(&y.cost)
-        .then(x.a.cmp(&y.a))
-        .then(x.b.cmp(&y.b))
+/// The order candidates are taken in: cost, then index in the pass's list (which is
+/// in order of first vertex). A total order (NaN costs are stored as +∞, see
+/// [`PassEngine::cost_edges`]).
+fn cheaper((x, i): (&Candidate, u32), (y, j): (&Candidate, u32)) -> Ordering {
+    x.cost.total_cmp(&y.cost).then(i.cmp(&j))
 }
 
 /// A live triangle around a vertex: its index and its current corners.
@@ -96,8 +96,6 @@ pub(super) struct PassEngine {
     live: Vec<u32>,
     /// Each input triangle's (unnormalised) normal in the normalised frame.
     original_normals: Vec<DVec3>,
-    /// `remap[v]` is what `v` became in this pass (itself, unless it was removed).
-    remap: Vec<u32>,
     /// The pass in which each vertex last moved or was removed.
     moved_in: Vec<u32>,
     pass: u32,
@@ -105,6 +103,11 @@ pub(super) struct PassEngine {
     first: Vec<u32>,
     incident: Vec<u32>,
     candidates: Vec<Candidate>,
+    /// Scratch of the batch selection: the batch's candidate indices, the cheapest at
+    /// each vertex, and the selected edges.
+    batch: Vec<u32>,
+    best: Vec<u32>,
+    selected: Vec<u32>,
     /// Where each vertex's edges (as the smaller end) start in `candidates`, as listed.
     listed_first: Vec<u32>,
     /// The last pass's edges and costs in listing order, and where each vertex's start.
@@ -141,12 +144,14 @@ impl PassEngine {
             triangles: cleaned.triangles.clone(),
             live: (0..cleaned.triangles.len() as u32).collect(),
             original_normals: Vec::new(),
-            remap: (0..n as u32).collect(),
             moved_in: vec![0; n],
             pass: 0,
             first: Vec::new(),
             incident: Vec::new(),
             candidates: Vec::new(),
+            batch: Vec::new(),
+            best: vec![u32::MAX; n],
+            selected: Vec::new(),
             listed_first: Vec::new(),
             last_listed: Vec::new(),
             last_listed_first: Vec::new(),
@@ -252,7 +257,7 @@ impl PassEngine {
             if corners[0] != REMOVED {
                 out.push(Around {
                     triangle: t,
-                    corners: corners.map(|c| self.remap[c as usize]),
+                    corners,
                 });
             }
         }
@@ -325,32 +330,44 @@ impl PassEngine {
         }
         self.list_edges();
         self.cost_edges();
-        // Each contraction of an interior edge removes two triangles: more candidates
-        // than that would only be skipped, and fewer keep the batch closer to the
-        // greedy order.
+        // Each contraction of an interior edge removes two triangles: a larger batch
+        // would overshoot, a smaller one keeps the pass closer to the greedy order.
         let needed = self.live.len() - target;
-        let mut batch = std::mem::take(&mut self.candidates);
-        let mut take = needed.div_ceil(2).clamp(1, batch.len().max(1));
-        let mut from = 0;
+        let edges = self.candidates.len();
+        let mut take = needed.div_ceil(2).clamp(1, edges.max(1));
         let mut live_count = self.live.len();
         let mut contracted = 0;
         let mut end = None;
-        // The cheapest `take`, in order; if every one of them is refused (or stale),
-        // the next cheapest, four times as many, and so on: costs have not changed
-        // while nothing was contracted.
-        while from < batch.len() {
-            if take < batch.len() {
-                batch[from..].select_nth_unstable_by(take - from - 1, cheaper);
-            }
-            batch[from..take].sort_unstable_by(cheaper);
-            for &Candidate { a, b, .. } in &batch[from..take] {
-                if live_count <= target {
+        let mut selected = std::mem::take(&mut self.selected);
+        let mut batch = std::mem::take(&mut self.batch);
+        self.list_batch(take, &mut batch);
+        // Rounds: the local minima of the batch are contracted (or refused), then the
+        // batch loses them and every edge at a vertex that moved, and the local minima
+        // of what is left go next, until none is left. If the whole pass contracts
+        // nothing, a batch four times larger, and so on (nothing has changed).
+        'rounds: loop {
+            if batch.is_empty() {
+                if contracted > 0 || take == edges {
                     break;
                 }
-                if self.moved_in[a as usize] == self.pass || self.moved_in[b as usize] == self.pass
-                {
-                    continue; // a stale cost: asked again next pass
+                take = take.saturating_mul(4).min(edges);
+                self.list_batch(take, &mut batch);
+                continue;
+            }
+            self.select_local_minima(&batch, &mut selected);
+            if selected.len() * 2 >= live_count - target {
+                // The round may reach the target: the cheapest first, so that the
+                // ones left out are the costliest, not the last in vertex order.
+                let candidates = &self.candidates;
+                selected.sort_unstable_by(|&x, &y| {
+                    cheaper((&candidates[x as usize], x), (&candidates[y as usize], y))
+                });
+            }
+            for &i in &selected {
+                if live_count <= target {
+                    break 'rounds;
                 }
+                let Candidate { a, b, .. } = self.candidates[i as usize];
                 match self.try_contract(a, b, live_count, observer) {
                     Attempt::Contracted { removed } => {
                         live_count -= removed;
@@ -359,7 +376,7 @@ impl PassEngine {
                     Attempt::Refused => {}
                     Attempt::OverErrorBound => {
                         end = Some(PassEnd::MaxErrorReached);
-                        break;
+                        break 'rounds;
                     }
                 }
                 self.since_report += 1;
@@ -372,19 +389,76 @@ impl PassEngine {
                     });
                     if observer.should_stop() {
                         end = Some(PassEnd::Cancelled);
-                        break;
+                        break 'rounds;
                     }
                 }
             }
-            if contracted > 0 || end.is_some() {
-                break;
-            }
-            from = take;
-            take = take.saturating_mul(4).min(batch.len());
+            // Attempted edges leave the batch (a refused one is asked again next
+            // pass), and so do edges at a moved vertex (their cost is stale).
+            selected.sort_unstable();
+            let (candidates, moved_in, pass) = (&self.candidates, &self.moved_in, self.pass);
+            let attempted = &selected;
+            batch.retain(|&i| {
+                let c = &candidates[i as usize];
+                moved_in[c.a as usize] != pass
+                    && moved_in[c.b as usize] != pass
+                    && attempted.binary_search(&i).is_err()
+            });
         }
-        self.candidates = batch;
-        self.rename_removed();
+        self.batch = batch;
+        self.selected = selected;
+        self.drop_removed();
         end.unwrap_or(PassEnd::Done { contracted })
+    }
+
+    /// The indices of this pass's batch, the `take` cheapest edges, into `batch`, in
+    /// listing order.
+    fn list_batch(&mut self, take: usize, batch: &mut Vec<u32>) {
+        let candidates = &self.candidates;
+        batch.clear();
+        batch.extend(0..candidates.len() as u32);
+        if take >= candidates.len() {
+            return;
+        }
+        let by_key = |&x: &u32, &y: &u32| {
+            cheaper((&candidates[x as usize], x), (&candidates[y as usize], y))
+        };
+        // The batch's largest key: the `take`-th smallest (cost, index).
+        let (_, &mut nth, _) = batch.select_nth_unstable_by(take - 1, by_key);
+        let bound = (&candidates[nth as usize], nth);
+        batch.clear();
+        batch.extend(
+            (0..candidates.len() as u32)
+                .filter(|&i| cheaper((&candidates[i as usize], i), bound).is_le()),
+        );
+    }
+
+    /// The edges of `batch` that are the cheapest of `batch` at both of their ends,
+    /// into `selected`, in the batch's order. No two of them share a vertex, and an
+    /// edge with a cheaper one next to it waits, as it would in the greedy order.
+    fn select_local_minima(&mut self, batch: &[u32], selected: &mut Vec<u32>) {
+        let candidates = &self.candidates;
+        for &i in batch {
+            let c = &candidates[i as usize];
+            for end in [c.a, c.b] {
+                let best = &mut self.best[end as usize];
+                if *best == u32::MAX
+                    || cheaper((c, i), (&candidates[*best as usize], *best)).is_lt()
+                {
+                    *best = i;
+                }
+            }
+        }
+        selected.clear();
+        selected.extend(batch.iter().copied().filter(|&i| {
+            let c = &candidates[i as usize];
+            self.best[c.a as usize] == i && self.best[c.b as usize] == i
+        }));
+        for &i in batch {
+            let c = &candidates[i as usize];
+            self.best[c.a as usize] = u32::MAX;
+            self.best[c.b as usize] = u32::MAX;
+        }
     }
 
     /// Lists every edge of the live triangles once, as (smaller end, larger end), in
@@ -533,16 +607,24 @@ impl PassEngine {
             return Attempt::Refused;
         }
         // The contraction itself.
-        self.remap[b as usize] = a;
         self.moved_in[a as usize] = self.pass;
         self.moved_in[b as usize] = self.pass;
         self.position[a as usize] = self.frame.to_normalized(world);
         self.world[a as usize] = world.to_array();
         self.quadric[a as usize] = q;
         let mut removed = 0;
-        for x in around[0].iter().filter(|x| x.corners.contains(&b)) {
-            self.triangles[x.triangle as usize][0] = REMOVED;
-            removed += 1;
+        for x in &around[0] {
+            if x.corners.contains(&b) {
+                self.triangles[x.triangle as usize][0] = REMOVED;
+                removed += 1;
+            }
+        }
+        // `b`'s other triangles are `a`'s now: renamed at once, so that every triangle
+        // read later in the pass has its current corners.
+        for x in &around[1] {
+            if !x.corners.contains(&a) {
+                self.triangles[x.triangle as usize] = x.corners.map(|c| if c == b { a } else { c });
+            }
         }
         self.counters.edge_contractions += 1;
         self.counters.max_error = self.counters.max_error.max(error);
@@ -691,19 +773,10 @@ impl PassEngine {
         false
     }
 
-    /// Takes the removed triangles off the live list and renames the removed vertices
-    /// in the others, ending the pass.
-    fn rename_removed(&mut self) {
-        let triangles = &mut self.triangles;
-        let remap = &self.remap;
-        self.live.retain(|&t| {
-            let corners = &mut triangles[t as usize];
-            if corners[0] == REMOVED {
-                return false;
-            }
-            *corners = corners.map(|c| remap[c as usize]);
-            true
-        });
+    /// Takes the removed triangles off the live list, ending the pass.
+    fn drop_removed(&mut self) {
+        let triangles = &self.triangles;
+        self.live.retain(|&t| triangles[t as usize][0] != REMOVED);
     }
 
     /// The live triangles with every vertex in model units (unreferenced vertices
