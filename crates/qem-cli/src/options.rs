@@ -5,8 +5,9 @@
 use crate::failure::Failure;
 use clap::{Args, ValueEnum};
 use qem_mesh::simplify::{
-    BoundaryMode, ContractionOrder, Length, QuadricMode, SimplifyOptions, Target, VirtualPairs,
-    Weighting, DEFAULT_BOUNDARY_WEIGHT, DEFAULT_MAX_NORMAL_ANGLE, DEFAULT_MIN_TRIANGLE_QUALITY,
+    BoundaryMode, ContractionOrder, Length, PlacementMode, QuadricMode, SimplifyOptions, Target,
+    VirtualPairs, Weighting, DEFAULT_BOUNDARY_WEIGHT, DEFAULT_MAX_NORMAL_ANGLE,
+    DEFAULT_MIN_TRIANGLE_QUALITY,
 };
 use std::path::{Path, PathBuf};
 
@@ -89,8 +90,8 @@ pub struct SimplifyFlags {
     #[arg(long)]
     pub preserve_topology: bool,
     /// Contract in passes over flat arrays instead of one pair at a time: several
-    /// times faster, a little less accurate. Uses summed quadrics and no orientation
-    /// check; cannot be combined with --quadrics, --preserve-topology or
+    /// times faster, a little less accurate. Uses summed quadrics, no orientation check
+    /// and the 3x3 solve's point without comparing it with the segment; cannot be combined with --quadrics, --preserve-topology or
     /// --pair-threshold [default: off].
     #[arg(long, conflicts_with_all = ["quadrics", "preserve_topology", "pair_threshold"])]
     pub fast: bool,
@@ -245,6 +246,7 @@ impl SimplifyFlags {
                 .with_order(ContractionOrder::Passes)
                 .with_quadrics(QuadricMode::Sum)
                 .with_orientation_check(false)
+                .with_placement(PlacementMode::SolveFirst)
         } else {
             options
         };

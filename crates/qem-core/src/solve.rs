@@ -175,6 +175,38 @@ pub fn optimal_placement(q: &Quadric, a: DVec3, b: DVec3) -> Placement {
     }
 }
 
+/// Garland–Heckbert's placement as published: the quadric's minimum whenever the 3x3
+/// solve succeeds, taken without comparing it with the segment and the ends; the
+/// segment rule ([`segment_placement`]) only when `A` is singular (or the minimum's
+/// cost is NaN). About half the work of [`optimal_placement`], whose comparison guards
+/// against rounding in nearly singular solves: here such a solve can cost more than
+/// the segment's best point would have.
+///
+/// ```
+/// use glam::DVec3;
+/// use qem_core::{optimal_placement, solve_first_placement, PlacementRule, Quadric};
+/// // Three planes meeting in (1, 2, 3): the same point as optimal_placement's.
+/// let q = Quadric::from_plane(DVec3::X, -1.0)
+///     + Quadric::from_plane(DVec3::Y, -2.0)
+///     + Quadric::from_plane(DVec3::Z, -3.0);
+/// let p = solve_first_placement(&q, DVec3::ZERO, DVec3::ONE);
+/// assert_eq!(p.rule, PlacementRule::Optimal);
+/// assert_eq!(p, optimal_placement(&q, DVec3::ZERO, DVec3::ONE));
+/// ```
+pub fn solve_first_placement(q: &Quadric, a: DVec3, b: DVec3) -> Placement {
+    if let Some(position) = minimize(q) {
+        let cost = q.evaluate(position);
+        if !cost.is_nan() {
+            return Placement {
+                position,
+                cost: cost.max(0.0),
+                rule: PlacementRule::Optimal,
+            };
+        }
+    }
+    segment_placement(q, a, b)
+}
+
 /// The best point on the segment `a`–`b`, or the best of the ends and the midpoint
 /// when the quadric is flat along the segment or rounding makes them better.
 #[inline]

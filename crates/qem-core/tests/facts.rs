@@ -2,8 +2,8 @@
 
 use approx::assert_relative_eq;
 use qem_core::{
-    endpoint_placement, minimize, optimal_placement, segment_placement, DVec3, Frame,
-    PlacementRule, Quadric,
+    endpoint_placement, minimize, optimal_placement, segment_placement, solve_first_placement,
+    DVec3, Frame, PlacementRule, Quadric,
 };
 
 #[test]
@@ -48,6 +48,26 @@ fn coplanar_faces_fall_back_to_the_segment() {
     assert_eq!(p.rule, PlacementRule::Segment);
     assert_relative_eq!(p.position.x, 0.3, epsilon = 1e-12);
     assert_relative_eq!(p.cost, 0.0, epsilon = 1e-15);
+}
+
+#[test]
+fn solve_first_falls_back_to_the_segment_only_when_singular() {
+    // The singular case of the test above: the same answer as optimal_placement's.
+    let q = Quadric::from_triangle(DVec3::ZERO, DVec3::X, DVec3::Y)
+        + Quadric::from_triangle(DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y)
+        + Quadric::from_plane(DVec3::X, -0.3);
+    let p = solve_first_placement(&q, DVec3::ZERO, DVec3::X);
+    assert_eq!(p, optimal_placement(&q, DVec3::ZERO, DVec3::X));
+    assert_eq!(p.rule, PlacementRule::Segment);
+    // Non-singular: the minimum (5, 5, 0) of the planes x = 5, y = 5, z = 0, far off
+    // the segment (0,0,0)-(1,0,0), whose best point costs 16 + 25.
+    let q = Quadric::from_plane(DVec3::X, -5.0)
+        + Quadric::from_plane(DVec3::Y, -5.0)
+        + Quadric::from_plane(DVec3::Z, 0.0);
+    let p = solve_first_placement(&q, DVec3::ZERO, DVec3::X);
+    assert_eq!(p.rule, PlacementRule::Optimal);
+    assert_eq!(p.position, DVec3::new(5.0, 5.0, 0.0));
+    assert_eq!(p.cost, 0.0);
 }
 
 #[test]

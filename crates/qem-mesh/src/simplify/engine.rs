@@ -12,8 +12,8 @@ use crate::queue::PairQueue;
 use crate::store::{slot_index, EdgeKey, FaceKey, MeshStore, SlotVec, VertexKey};
 use crate::IndexedMesh;
 use qem_core::{
-    endpoint_placement, optimal_placement, unit_normal_and_area, DVec3, Frame, Placement,
-    PlacementRule, Quadric, WeightedPlane,
+    endpoint_placement, optimal_placement, solve_first_placement, unit_normal_and_area, DVec3,
+    Frame, Placement, PlacementRule, Quadric, WeightedPlane,
 };
 use rayon::prelude::*;
 use slotmap::{Key, SecondaryMap};
@@ -99,6 +99,7 @@ pub(super) fn place_merged(
     match placement {
         PlacementMode::Optimal => optimal_placement(q, pa, pb),
         PlacementMode::EndpointOrMidpoint => endpoint_placement(q, pa, pb),
+        PlacementMode::SolveFirst => solve_first_placement(q, pa, pb),
     }
 }
 
