@@ -106,6 +106,9 @@ pub(super) struct PassEngine {
     /// Scratch of the batch selection: the batch's candidate indices, the cheapest at
     /// each vertex, and the selected edges.
     batch: Vec<u32>,
+    keys: Vec<(f64, u32)>,
+    /// Whether each candidate was attempted in this pass.
+    tried: Vec<bool>,
     best: Vec<u32>,
     selected: Vec<u32>,
     /// Where each vertex's edges (as the smaller end) start in `candidates`, as listed.
@@ -150,6 +153,8 @@ impl PassEngine {
             incident: Vec::new(),
             candidates: Vec::new(),
             batch: Vec::new(),
+            keys: Vec::new(),
+            tried: Vec::new(),
             best: vec![u32::MAX; n],
             selected: Vec::new(),
             listed_first: Vec::new(),
@@ -341,6 +346,8 @@ impl PassEngine {
         let mut selected = std::mem::take(&mut self.selected);
         let mut batch = std::mem::take(&mut self.batch);
         self.list_batch(take, &mut batch);
+        self.tried.clear();
+        self.tried.resize(edges, false);
         // Rounds: the local minima of the batch are contracted (or refused), then the
         // batch loses them and every edge at a vertex that moved, and the local minima
         // of what is left go next, until none is left. If the whole pass contracts
@@ -395,14 +402,16 @@ impl PassEngine {
             }
             // Attempted edges leave the batch (a refused one is asked again next
             // pass), and so do edges at a moved vertex (their cost is stale).
-            selected.sort_unstable();
-            let (candidates, moved_in, pass) = (&self.candidates, &self.moved_in, self.pass);
-            let attempted = &selected;
+            for &i in &selected {
+                self.tried[i as usize] = true;
+            }
+            let (candidates, moved_in, pass, tried) =
+                (&self.candidates, &self.moved_in, self.pass, &self.tried);
             batch.retain(|&i| {
                 let c = &candidates[i as usize];
                 moved_in[c.a as usize] != pass
                     && moved_in[c.b as usize] != pass
-                    && attempted.binary_search(&i).is_err()
+                    && !tried[i as usize]
             });
         }
         self.batch = batch;
@@ -416,20 +425,23 @@ impl PassEngine {
     fn list_batch(&mut self, take: usize, batch: &mut Vec<u32>) {
         let candidates = &self.candidates;
         batch.clear();
-        batch.extend(0..candidates.len() as u32);
         if take >= candidates.len() {
+            batch.extend(0..candidates.len() as u32);
             return;
         }
-        let by_key = |&x: &u32, &y: &u32| {
-            cheaper((&candidates[x as usize], x), (&candidates[y as usize], y))
-        };
-        // The batch's largest key: the `take`-th smallest (cost, index).
-        let (_, &mut nth, _) = batch.select_nth_unstable_by(take - 1, by_key);
-        let bound = (&candidates[nth as usize], nth);
-        batch.clear();
+        // The batch's largest key, the `take`-th smallest (cost, index), selected
+        // among copies of the keys (not through the indices: a third of the work).
+        self.keys.clear();
+        self.keys
+            .extend(candidates.iter().zip(0u32..).map(|(c, i)| (c.cost, i)));
+        let by_key = |x: &(f64, u32), y: &(f64, u32)| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1));
+        let (_, &mut bound, _) = self.keys.select_nth_unstable_by(take - 1, by_key);
         batch.extend(
-            (0..candidates.len() as u32)
-                .filter(|&i| cheaper((&candidates[i as usize], i), bound).is_le()),
+            candidates
+                .iter()
+                .zip(0u32..)
+                .filter(|&(c, i)| by_key(&(c.cost, i), &bound).is_le())
+                .map(|(_, i)| i),
         );
     }
 
