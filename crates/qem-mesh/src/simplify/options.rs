@@ -158,7 +158,11 @@ pub enum ContractionOrder {
     /// [`QuadricMode::Exact`], `orientation_check`, `preserve_topology` and a
     /// `pair_threshold` above zero with
     /// [`SimplifyError::NotInPasses`](super::SimplifyError::NotInPasses).
-    /// [`SimplifyOptions::FAST`] is the defaults with this order.
+    /// [`SimplifyOptions::FAST`] is the defaults with this order. With a
+    /// [`max_error`](SimplifyOptions::max_error) bound, no pair over the bound is
+    /// contracted, and the run stops with
+    /// [`StopReason::MaxErrorReached`](super::StopReason::MaxErrorReached) when a pass
+    /// finds none under it.
     Passes,
 }
 
@@ -248,7 +252,8 @@ pub struct SimplifyOptions {
     /// Run the store's full invariant check ([`MeshStore::validate`](crate::MeshStore::validate))
     /// after every contraction and fail with
     /// [`SimplifyError::Internal`](super::SimplifyError::Internal) if it breaks. For
-    /// tests: it costs O(n) per contraction. Default: `false`.
+    /// tests: it costs O(n) per contraction. The pass-based order has no store and
+    /// ignores it. Default: `false`.
     pub validate_each_contraction: bool,
 }
 

@@ -72,7 +72,8 @@ struct Around {
 enum PassEnd {
     /// Ran out of candidates (or reached the target); `contracted` in this pass.
     Done { contracted: usize },
-    /// The next candidate's error was above the bound.
+    /// Nothing was contracted, and at least one candidate's error was above the
+    /// bound.
     MaxErrorReached,
     /// The observer asked to stop.
     Cancelled,
@@ -343,6 +344,7 @@ impl PassEngine {
         let mut live_count = self.live.len();
         let mut contracted = 0;
         let mut end = None;
+        let mut over_bound = false;
         let mut selected = std::mem::take(&mut self.selected);
         let mut batch = std::mem::take(&mut self.batch);
         self.list_batch(take, &mut batch);
@@ -359,6 +361,8 @@ impl PassEngine {
                 }
                 take = take.saturating_mul(4).min(edges);
                 self.list_batch(take, &mut batch);
+                let tried = &self.tried;
+                batch.retain(|&i| !tried[i as usize]);
                 continue;
             }
             self.select_local_minima(&batch, &mut selected);
@@ -381,10 +385,8 @@ impl PassEngine {
                         contracted += 1;
                     }
                     Attempt::Refused => {}
-                    Attempt::OverErrorBound => {
-                        end = Some(PassEnd::MaxErrorReached);
-                        break 'rounds;
-                    }
+                    // Never contracted; the pass goes on with the pairs under the bound.
+                    Attempt::OverErrorBound => over_bound = true,
                 }
                 self.since_report += 1;
                 if self.since_report >= OBSERVER_INTERVAL {
@@ -417,7 +419,11 @@ impl PassEngine {
         self.batch = batch;
         self.selected = selected;
         self.drop_removed();
-        end.unwrap_or(PassEnd::Done { contracted })
+        match end {
+            Some(end) => end,
+            None if contracted == 0 && over_bound => PassEnd::MaxErrorReached,
+            None => PassEnd::Done { contracted },
+        }
     }
 
     /// The indices of this pass's batch, the `take` cheapest edges, into `batch`, in
@@ -825,7 +831,7 @@ enum Attempt {
     Contracted { removed: usize },
     /// Refused by a check (counted) or to keep the last triangles.
     Refused,
-    /// The pair's error is above the bound.
+    /// The pair's error is above the bound: not contracted.
     OverErrorBound,
 }
 
