@@ -267,8 +267,14 @@ fn options_the_passes_lack_are_refused_by_name() {
         assert!(message.contains(name), "{message}");
         assert!(message.contains("ContractionOrder::Passes"), "{message}");
     }
-    // A zero threshold, relative or absolute, is edges only: accepted.
-    for zero in [Length::DiagonalFraction(0.0), Length::Absolute(0.0)] {
+    // A zero threshold, relative or absolute, is edges only: accepted; so are a
+    // negative and a NaN one, which count as zero (documented on `Length`).
+    for zero in [
+        Length::DiagonalFraction(0.0),
+        Length::Absolute(0.0),
+        Length::DiagonalFraction(-0.5),
+        Length::Absolute(f64::NAN),
+    ] {
         let out = simplify(&sphere, &fast(Target::Ratio(0.5)).with_pair_threshold(zero));
         assert!(out.is_ok(), "{zero:?}: {out:?}");
     }
@@ -345,6 +351,74 @@ fn two_parts_never_merge_without_virtual_pairs() {
     for (kept, removed) in pairs.0 {
         assert_eq!(kept < split, removed < split, "{kept} and {removed}");
     }
+}
+
+// Three bumpy 4 × 4 sheets sharing one bent spine of 5 vertices (every spine edge is
+// a fin of three triangles) at ratio 0.6: contracting a spine edge removes its three
+// triangles, and what is left still has a fin; the cleaning welds the spine (10
+// vertices).
+#[test]
+fn fin_edges_survive_at_ratio_0_6() {
+    let wing = |angle: f64| {
+        let (s, c) = angle.sin_cos();
+        let mut positions = Vec::new();
+        for z in 0..=4 {
+            for u in 0..=4 {
+                let (u, z) = (f64::from(u), f64::from(z));
+                positions.push([0.15 * z * z + u * c, u * s, z]);
+            }
+        }
+        IndexedMesh::new(positions, grid(4, 4, 0.0).triangles)
+    };
+    let fin = concat(&[wing(1.0), wing(3.0), wing(5.0)]);
+    let n = fin.triangle_count();
+    let welded = qem_mesh::clean::clean(&fin, &qem_mesh::clean::CleanOptions::DEFAULT).mesh;
+    assert_eq!(
+        border_and_nonmanifold_edges(&welded).1,
+        4,
+        "the spine's 4 edges"
+    );
+    let out = simplify(&fin, &fast(Target::Ratio(0.6))).unwrap();
+    check_run(&out, n);
+    assert_eq!(out.report.cleanup.welded_vertices, 10);
+    assert_eq!(out.report.stop_reason, StopReason::TargetReached);
+    assert!(
+        border_and_nonmanifold_edges(&out.mesh).1 >= 1,
+        "{:?}",
+        out.mesh
+    );
+    assert_eq!(components(&out.mesh), 1);
+}
+
+// The observer hears of every contraction: as many events as the report counts, none
+// virtual, and a vertex once removed never appears again (as kept or removed).
+#[test]
+fn contraction_events_match_the_report() {
+    struct Pairs(Vec<Contraction>);
+    impl Observer for Pairs {
+        fn contracted(&mut self, c: &Contraction) {
+            self.0.push(*c);
+        }
+    }
+    let sphere = noisy_sphere(16, 32);
+    let mut events = Pairs(Vec::new());
+    let out = simplify_observed(&sphere, &fast(Target::Ratio(0.1)), &mut events).unwrap();
+    check_run(&out, sphere.triangle_count());
+    assert_eq!(events.0.len(), out.report.edge_contractions);
+    let mut removed = BTreeSet::new();
+    for c in &events.0 {
+        assert!(!c.is_virtual);
+        assert!(c.cost >= 0.0 && c.cost.is_finite(), "{c:?}");
+        assert!(
+            !removed.contains(&c.kept) && !removed.contains(&c.removed),
+            "{c:?}"
+        );
+        assert!(removed.insert(c.removed));
+    }
+    assert_eq!(
+        removed.len(),
+        sphere.vertex_count() - out.mesh.vertex_count()
+    );
 }
 
 // On a closed manifold every contraction removes one vertex and two triangles, so the
@@ -435,6 +509,77 @@ fn the_observer_can_cancel_a_pass_run() {
         observer.0.len() >= 2,
         "a report when polled and one at the end"
     );
+}
+
+// Regression (found by `passes_soups` on main at 6c1fdaf, where each pass contracts
+// its batch in rounds): a contraction that removes more triangles than were still
+// needed leaves the count below the target with edges of the batch left for another
+// round, which computed `live − target` and overflowed (a panic in debug builds). An
+// unwelded soup with duplicate and zero-area faces kept: 13 triangles, target 8.
+#[test]
+fn regression_a_round_after_the_target_was_passed_uncleaned_soup() {
+    let mesh = IndexedMesh::new(
+        vec![
+            [1.0, 2.0, 1.0],
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 3.0],
+            [0.0, 1.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [0.0, 0.0, 3.0],
+            [2.0, 1.0, 0.0],
+        ],
+        vec![
+            [4, 5, 2],
+            [2, 5, 1],
+            [1, 0, 2],
+            [1, 1, 0],
+            [0, 1, 2],
+            [5, 1, 0],
+            [0, 2, 2],
+            [0, 1, 3],
+            [2, 6, 4],
+            [0, 0, 0],
+            [1, 3, 2],
+            [2, 5, 3],
+            [1, 2, 4],
+        ],
+    );
+    let o = fast(Target::Ratio(0.6397870871369739)).with_clean(
+        qem_mesh::clean::CleanOptions::DEFAULT
+            .with_weld_exact(false)
+            .with_drop_zero_area(false)
+            .with_drop_duplicates(false),
+    );
+    let out = simplify(&mesh, &o).unwrap();
+    check_run(&out, 13);
+    assert_eq!(out.report.target_triangles, 8);
+}
+
+// The same on a bumpy 5 × 9 grid (90 triangles) with its border locked, target 81.
+#[test]
+fn regression_a_round_after_the_target_was_passed_locked_border_grid() {
+    #[rustfmt::skip]
+    let heights = [
+        0.0, -0.5, 0.0, 0.0, 0.0, 0.0,
+        0.0, -1.0, 0.5, 0.0, -0.5, 0.0,
+        0.0, -1.0, 0.0, 0.0, 0.0, 1.0,
+        0.0, 0.5, 0.5, 0.0, -1.0, 1.0,
+        0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+        0.0, 0.0, 0.0, 0.5, 0.0, 0.0,
+        -1.0, 0.0, 1.0, 0.5, 0.0, 1.0,
+        0.0, 0.5, 0.5, 0.5, 0.0, 0.5,
+        0.0, 0.0, 0.0, 0.0, -0.5, 0.0,
+        0.0, 0.0, 0.5, 0.0, 0.0, 0.5,
+    ];
+    let mut sheet = grid(5, 9, 0.0);
+    for (p, h) in sheet.positions.iter_mut().zip(heights) {
+        p[2] = h;
+    }
+    let o = fast(Target::Ratio(0.9026079954706878)).with_boundary(BoundaryMode::Locked);
+    let out = simplify(&sheet, &o).unwrap();
+    check_run(&out, 90);
+    assert_eq!(out.report.target_triangles, 81);
+    assert_eq!(border_loops(&out.mesh), 1);
 }
 
 /// Messy corpus meshes at ratio 0.1: a valid output whose report agrees with it, no

@@ -11,10 +11,11 @@ use passes_common::{bits, border_loops, zero_area_faces_in_input_frame};
 use proptest::prelude::*;
 use qem_mesh::clean::{clean, CleanOptions, Cleaned};
 use qem_mesh::simplify::{
-    simplify, BoundaryMode, PlacementMode, SimplifyError, SimplifyOptions, StopReason, Target,
-    Weighting, DEFAULT_MAX_NORMAL_ANGLE,
+    simplify, simplify_observed, BoundaryMode, Contraction, Observer, PlacementMode, SimplifyError,
+    SimplifyOptions, StopReason, Target, Weighting, DEFAULT_MAX_NORMAL_ANGLE,
 };
 use qem_mesh::IndexedMesh;
+use std::collections::BTreeSet;
 
 /// Up to `max_vertices` vertices on a 4×4×4 integer grid and 1 to 40 faces with any
 /// indices (repeated ones included).
@@ -118,14 +119,15 @@ fn fast_options() -> impl Strategy<Value = SimplifyOptions> {
 /// finite, every vertex used, no more triangles than the input, no zero-area face by
 /// `clean`'s rule, in the simplifier's frame and in the output's own) or a documented
 /// error (invalid input, a locked vertex out of range, nothing left after cleaning); the report
-/// agrees with the output; locked vertices that cleaning kept come out where they were;
+/// agrees with the output and with the observer's contraction events; locked vertices that cleaning kept come out where they were;
 /// no flipped face while the normal check is on; the same result twice, bit for bit.
 /// Returns the output, if any.
 fn check_fast(
     mesh: &IndexedMesh,
     o: &SimplifyOptions,
 ) -> Result<Option<IndexedMesh>, TestCaseError> {
-    let first = simplify(mesh, o);
+    let mut events = Events(Vec::new());
+    let first = simplify_observed(mesh, o, &mut events);
     let result = match &first {
         Err(SimplifyError::Input(e)) => {
             prop_assert_eq!(mesh.validate(), Err(e.clone()), "refused a valid input");
@@ -166,7 +168,28 @@ fn check_fast(
             if o.max_normal_angle < 180.0 {
                 prop_assert_eq!(r.faces_flipped, 0);
             }
+            // One event per contraction; a removed vertex never comes back, and a
+            // locked one is never removed (events use the cleaned mesh's indices).
+            prop_assert_eq!(events.0.len(), r.edge_contractions);
             let kept = clean(mesh, &o.clean);
+            let locked: BTreeSet<u32> = o
+                .locked_vertices
+                .iter()
+                .map(|&i| kept.vertex_map[i as usize])
+                .collect();
+            let mut removed = BTreeSet::new();
+            for &(a, b, is_virtual) in &events.0 {
+                prop_assert!(!is_virtual);
+                prop_assert!(a != b);
+                prop_assert!(
+                    !removed.contains(&a) && !removed.contains(&b),
+                    "{} {}",
+                    a,
+                    b
+                );
+                prop_assert!(!locked.contains(&b), "locked {} removed", b);
+                removed.insert(b);
+            }
             let present = passes_common::position_bits(&out.mesh);
             for &i in &o.locked_vertices {
                 if kept.vertex_map[i as usize] != Cleaned::REMOVED {
@@ -196,6 +219,15 @@ fn check_fast(
         _ => prop_assert!(false, "two runs disagree"),
     }
     Ok(result)
+}
+
+/// The observer's contraction events: (kept, removed, virtual).
+struct Events(Vec<(u32, u32, bool)>);
+
+impl Observer for Events {
+    fn contracted(&mut self, c: &Contraction) {
+        self.0.push((c.kept, c.removed, c.is_virtual));
+    }
 }
 
 proptest! {
