@@ -2,9 +2,11 @@
 
 use super::bytes::Bytes;
 use crate::mesh_checks::assert_valid_output;
+use qem_core::{DVec3, Frame};
 use qem_mesh::clean::{clean, CleanOptions};
 use qem_mesh::simplify::{
-    simplify, Length, PlacementMode, SimplifyError, SimplifyOptions, StopReason, Target, Weighting,
+    simplify, ContractionOrder, Length, PlacementMode, QuadricMode, SimplifyError, SimplifyOptions,
+    StopReason, Target, Weighting,
 };
 use qem_mesh::IndexedMesh;
 
@@ -19,16 +21,54 @@ const OFFSETS: [f64; 4] = [0.0, 1.0, 1e6, -1e12];
 /// At most this many faces, so one run stays in the millisecond range.
 const MAX_FACES: usize = 48;
 
+/// In [`ContractionOrder::Passes`], the one option of those it lacks that the input
+/// asks for anyway (to check the refusal), with the name
+/// [`SimplifyError::NotInPasses`] must give.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Lacking {
+    ExactQuadrics,
+    OrientationCheck,
+    PreserveTopology,
+    PairThreshold,
+}
+
+impl Lacking {
+    fn name(self) -> &'static str {
+        match self {
+            Lacking::ExactQuadrics => "quadrics = Exact",
+            Lacking::OrientationCheck => "orientation_check = true",
+            Lacking::PreserveTopology => "preserve_topology = true",
+            Lacking::PairThreshold => "pair_threshold above zero (virtual pairs)",
+        }
+    }
+}
+
 /// A soup of up to 16 vertices on a 5×5×5 grid (scaled and offset) and up to 48 faces,
-/// with options, from fuzz bytes.
+/// with options, from fuzz bytes; and, in the pass-based order, the lacking option
+/// asked for, if any.
 ///
-/// Layout: vertex count, target kind and value, option flags, pair threshold, max
-/// error, virtual-pair cap, weld tolerance, scale, offset; then three bytes per vertex
-/// (grid coordinates), then three per face (indices modulo the vertex count).
-fn decode(data: &[u8]) -> (IndexedMesh, SimplifyOptions) {
+/// Layout: vertex count, target kind (and order) and value, option flags, pair
+/// threshold, max error, virtual-pair cap, weld tolerance, scale, offset; then three
+/// bytes per vertex (grid coordinates), then three per face (indices modulo the vertex
+/// count).
+///
+/// The target kind is the low two bits of its byte. Bit 6 of that byte picks
+/// [`ContractionOrder::Passes`] (with summed quadrics, no orientation check and no
+/// virtual pairs, as in [`SimplifyOptions::FAST`]); with it, bit 7 asks for one option
+/// that order lacks, chosen by bits 2–3. No committed seed from before the pass-based
+/// order has bit 6 set, so each still decodes to the same greedy case.
+fn decode(data: &[u8]) -> (IndexedMesh, SimplifyOptions, Option<Lacking>) {
     let mut b = Bytes::new(data);
     let n = 3 + b.below(14);
-    let target = match (b.below(4), b.byte()) {
+    let kind = b.byte();
+    let passes = kind & 0x40 != 0;
+    let lacking = (passes && kind & 0x80 != 0).then_some(match (kind >> 2) & 3 {
+        0 => Lacking::ExactQuadrics,
+        1 => Lacking::OrientationCheck,
+        2 => Lacking::PreserveTopology,
+        _ => Lacking::PairThreshold,
+    });
+    let target = match (kind % 4, b.byte()) {
         (0, x) => Target::Ratio(f64::from(x) / 255.0),
         (1, x) => Target::Triangles(usize::from(x)),
         (2, _) => Target::None,
@@ -55,7 +95,7 @@ fn decode(data: &[u8]) -> (IndexedMesh, SimplifyOptions) {
         .with_drop_zero_area(!flag(5))
         .with_drop_duplicates(!flag(6))
         .with_weld_tolerance(flag(7).then_some(tolerance * scale));
-    let options = SimplifyOptions::DEFAULT
+    let mut options = SimplifyOptions::DEFAULT
         .with_target(target)
         .with_placement(if flag(0) {
             PlacementMode::EndpointOrMidpoint
@@ -74,6 +114,19 @@ fn decode(data: &[u8]) -> (IndexedMesh, SimplifyOptions) {
         .with_max_virtual_pairs_per_vertex(cap)
         .with_clean(clean_options)
         .with_validate_each_contraction(true);
+    if passes {
+        options = options
+            .with_order(ContractionOrder::Passes)
+            .with_quadrics(QuadricMode::Sum)
+            .with_orientation_check(false);
+        match lacking {
+            Some(Lacking::ExactQuadrics) => options = options.with_quadrics(QuadricMode::Exact),
+            Some(Lacking::OrientationCheck) => options = options.with_orientation_check(true),
+            Some(Lacking::PreserveTopology) => options = options.with_preserve_topology(true),
+            Some(Lacking::PairThreshold) => {} // as decoded, perhaps zero
+            None => options = options.with_pair_threshold(Length::DiagonalFraction(0.0)),
+        }
+    }
 
     let positions = (0..n)
         .map(|_| [(); 3].map(|()| f64::from(b.byte() % 5) * scale + offset))
@@ -82,16 +135,45 @@ fn decode(data: &[u8]) -> (IndexedMesh, SimplifyOptions) {
     while !b.is_empty() && triangles.len() < MAX_FACES {
         triangles.push([(); 3].map(|()| b.below(n) as u32));
     }
-    (IndexedMesh::new(positions, triangles), options)
+    (IndexedMesh::new(positions, triangles), options, lacking)
+}
+
+/// Whether `simplify` must refuse `options` in the pass-based order once `mesh` is
+/// cleaned (and has triangles left): always for the lacking option asked for, except a
+/// pair threshold that is zero in the simplifier's frame (a negative or NaN [`Length`]
+/// counts as zero, as its documentation says).
+fn must_refuse(mesh: &IndexedMesh, options: &SimplifyOptions, lacking: Lacking) -> bool {
+    if lacking != Lacking::PairThreshold {
+        return true;
+    }
+    let cleaned = clean(mesh, &options.clean).mesh;
+    let frame = Frame::from_points(cleaned.positions.iter().map(|p| DVec3::from_array(*p)));
+    let normalized = match options.pair_threshold {
+        Length::DiagonalFraction(f) => frame.diagonal_fraction_to_distance(f),
+        Length::Absolute(d) => frame.distance_to_normalized(d),
+    };
+    normalized > 0.0
 }
 
 /// `simplify_soup`: whatever the soup and options, `simplify` gives a valid mesh with a
-/// consistent report, or the documented error for an invalid or fully degenerate input;
-/// the store's invariants hold after every contraction; and a second run gives the same
-/// result bit for bit.
+/// consistent report, or the documented error for an invalid or fully degenerate input
+/// or for an option the pass-based order lacks; in the greedy order the store's
+/// invariants hold after every contraction, in the pass-based order no output face is
+/// flipped; and a second run gives the same result bit for bit.
 pub fn simplify_soup(data: &[u8]) {
-    let (mesh, options) = decode(data);
+    let (mesh, options, lacking) = decode(data);
+    let passes = options.order == ContractionOrder::Passes;
     let first = simplify(&mesh, &options);
+    if let Some(lacking) = lacking {
+        let refused = matches!(first, Err(SimplifyError::NotInPasses { .. }));
+        let reached =
+            mesh.validate().is_ok() && !clean(&mesh, &options.clean).mesh.triangles.is_empty();
+        assert_eq!(
+            refused,
+            reached && must_refuse(&mesh, &options, lacking),
+            "{lacking:?}: {first:?}"
+        );
+    }
     match &first {
         Err(SimplifyError::Input(e)) => {
             assert_eq!(mesh.validate(), Err(e.clone()), "refused a valid input");
@@ -105,6 +187,13 @@ pub fn simplify_soup(data: &[u8]) {
                     || !options.clean.drop_zero_area,
                 "refused an input with triangles left after cleaning"
             );
+        }
+        Err(SimplifyError::NotInPasses { option }) => {
+            let lacking = lacking.expect("refused only what the input asked for");
+            assert_eq!(*option, lacking.name());
+            assert!(first
+                .as_ref()
+                .is_err_and(|e| e.to_string().contains(option)));
         }
         Err(e) => panic!("unexpected error: {e}"),
         Ok(out) => {
@@ -123,8 +212,13 @@ pub fn simplify_soup(data: &[u8]) {
             if r.stop_reason == StopReason::TargetReached {
                 assert!(r.triangles_out <= r.target_triangles, "{r:?}");
             }
-            if options.pair_threshold == Length::DiagonalFraction(0.0) {
+            if options.pair_threshold == Length::DiagonalFraction(0.0) || passes {
                 assert_eq!(r.virtual_contractions, 0);
+            }
+            if passes {
+                // The fold-over check's default 90° limit also refuses a face turned
+                // more than 90° from the input face it descends from.
+                assert_eq!(r.faces_flipped, 0, "{r:?}");
             }
         }
     }
@@ -144,5 +238,67 @@ pub fn simplify_soup(data: &[u8]) {
         }
         (Err(a), Err(b)) => assert_eq!(a, b),
         (a, b) => panic!("two runs disagree: {a:?} then {b:?}"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    /// The committed seeds, by file name.
+    fn seeds() -> Vec<(String, Vec<u8>)> {
+        let mut seeds = Vec::new();
+        for kind in ["corpus", "regressions"] {
+            let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../fuzz")
+                .join(kind)
+                .join("simplify_soup");
+            for entry in std::fs::read_dir(&dir).expect("the committed seeds") {
+                let path = entry.expect("a directory entry").path();
+                let name = path.file_name().expect("a file").to_string_lossy().into();
+                seeds.push((name, std::fs::read(&path).expect("a readable seed")));
+            }
+        }
+        seeds.sort();
+        seeds
+    }
+
+    /// The seeds from before the pass-based order still decode to greedy runs (the
+    /// format stayed compatible); those named `_passes` run in passes, and those named
+    /// `_refuses_` ask for the option they name and are refused with its name.
+    #[test]
+    fn seeds_decode_to_the_order_their_name_says() {
+        let seeds = seeds();
+        assert!(seeds.iter().filter(|(n, _)| n.contains("_passes")).count() >= 6);
+        for (name, data) in seeds {
+            let (mesh, options, lacking) = decode(&data);
+            let want = if name.contains("_passes") {
+                ContractionOrder::Passes
+            } else {
+                ContractionOrder::Greedy
+            };
+            assert_eq!(options.order, want, "{name}");
+            // Only a seed that asks for a lacking option runs here (the replay test
+            // runs them all through the whole check).
+            let refused = match lacking.map(|_| simplify(&mesh, &options)) {
+                Some(Err(SimplifyError::NotInPasses { option })) => Some(option),
+                _ => None,
+            };
+            match name.split_once("_refuses_") {
+                Some((_, what)) => {
+                    let asked = match what {
+                        "exact_quadrics" => Lacking::ExactQuadrics,
+                        "orientation_check" => Lacking::OrientationCheck,
+                        "preserve_topology" => Lacking::PreserveTopology,
+                        "pair_threshold" => Lacking::PairThreshold,
+                        _ => panic!("{name}: refuses what?"),
+                    };
+                    assert_eq!(lacking, Some(asked), "{name}");
+                    assert_eq!(refused, Some(asked.name()), "{name}");
+                }
+                None => assert_eq!(refused, None, "{name}"),
+            }
+        }
     }
 }
