@@ -355,6 +355,11 @@ impl PassEngine {
         // of what is left go next, until none is left. If the whole pass contracts
         // nothing, a batch four times larger, and so on (nothing has changed).
         'rounds: loop {
+            // A contraction can remove more triangles than were still needed (a
+            // vertex of a non-manifold fan), so the target can be passed mid-round.
+            if live_count <= target {
+                break;
+            }
             if batch.is_empty() {
                 if contracted > 0 || take == edges {
                     break;
