@@ -13,7 +13,9 @@
 //! Submodules, one job each: `options` (what a run may do), `report` (what it did),
 //! `observer` (progress, cancellation, per-contraction events), `engine` (the loop),
 //! `checks` (which contractions are allowed), `exact` (the inclusion–exclusion
-//! bookkeeping of [`QuadricMode::Exact`]).
+//! bookkeeping of [`QuadricMode::Exact`]), `passes` (the pass-based order,
+//! [`ContractionOrder::Passes`], on flat arrays instead of the store: the same checks
+//! but no heap; [`SimplifyOptions::FAST`]).
 
 mod checks;
 mod engine;
