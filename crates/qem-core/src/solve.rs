@@ -8,8 +8,10 @@
 //! 3. Otherwise, or when rounding made the above worse, the best of the two ends and the
 //!    midpoint.
 //!
-//! The result never costs more than the ends and the midpoint, and a finite input never
-//! gives a non-finite point.
+//! [`optimal_placement`]'s result never costs more than the ends and the midpoint, and
+//! a finite input never gives a non-finite point. [`solve_first_placement`] skips the
+//! comparison behind the first half of that guarantee (step 3's "when rounding made the
+//! above worse"), for speed.
 
 use crate::Quadric;
 use glam::DVec3;

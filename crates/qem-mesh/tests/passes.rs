@@ -14,6 +14,7 @@ use passes_common::{
     bits, border_and_nonmanifold_edges, border_loops, border_vertices, components, noisy_sphere,
     position_bits,
 };
+use qem_mesh::clean::CleanOptions;
 use qem_mesh::simplify::{
     simplify, simplify_levels, simplify_observed, BoundaryMode, Contraction, ContractionOrder,
     Length, NoObserver, Observer, Progress, QuadricMode, Simplified, SimplifyError,
@@ -637,4 +638,71 @@ fn messy_corpus_meshes_at_ratio_0_1() {
         let again = simplify(&mesh, &fast(Target::Ratio(0.1))).unwrap();
         assert_eq!(bits(&again.mesh), bits(&out.mesh), "{name}");
     }
+}
+
+// A triangle with a repeated corner is not a triangle: the pass-based order must not
+// count it as live (found in review). Cleaning off, so it reaches the simplifier:
+//
+//   2          4
+//   | \        (3 3 4: a "triangle" with a repeated corner, far away)
+//   0---1      3
+//
+// With a target of 1, the real triangle 0 1 2 must survive; counting 3 3 4 as live
+// let the run contract the last real one and fail with NothingLeftAfterCleaning.
+#[test]
+fn a_triangle_with_a_repeated_corner_is_not_live() {
+    let mesh = IndexedMesh::new(
+        vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [5.0, 5.0, 5.0],
+            [6.0, 5.0, 5.0],
+        ],
+        vec![[0, 1, 2], [3, 3, 4]],
+    );
+    let options = fast(Target::Triangles(1))
+        .with_boundary(BoundaryMode::Free)
+        .with_clean(
+            CleanOptions::DEFAULT
+                .with_drop_repeated_index(false)
+                .with_drop_zero_area(false),
+        );
+    for order in [ContractionOrder::Greedy, ContractionOrder::Passes] {
+        let out = simplify(
+            &mesh,
+            &options
+                .clone()
+                .with_order(order)
+                .with_quadrics(QuadricMode::Sum),
+        )
+        .unwrap_or_else(|e| panic!("{order:?}: {e}"));
+        assert_eq!(out.mesh.triangles, vec![[0, 1, 2]], "{order:?}");
+        assert_eq!(out.report.edge_contractions, 0, "{order:?}");
+    }
+}
+
+// A fan of 2,000 triangles around one vertex, flat, with free borders: every cost is
+// exactly 0, so only the tie-break orders each batch, and the hub has 2,000 triangles
+// (the border search's long path). The run must reach its target with a valid mesh.
+// (How fast it gets there is a benchmark's business: BENCHMARKS.md, "The pass-based
+// order", gives the pass counts before and after ties were scattered.)
+#[test]
+fn a_flat_fan_reaches_its_target() {
+    let n = 2000u32;
+    let mut positions = vec![[0.0, 0.0, 0.0]];
+    positions.extend((0..n).map(|i| {
+        let t = std::f64::consts::TAU * f64::from(i) / f64::from(n);
+        [t.cos(), t.sin(), 0.0]
+    }));
+    let triangles = (0..n).map(|i| [0, i + 1, (i + 1) % n + 1]).collect();
+    let mesh = IndexedMesh::new(positions, triangles);
+    let out = simplify(
+        &mesh,
+        &fast(Target::Ratio(0.1)).with_boundary(BoundaryMode::Free),
+    )
+    .expect("a fan simplifies");
+    assert_eq!(out.report.stop_reason, StopReason::TargetReached);
+    assert!(out.mesh.triangle_count() <= 200);
+    assert_valid(&out.mesh, n as usize);
 }

@@ -83,7 +83,11 @@ fn fast_options() -> impl Strategy<Value = SimplifyOptions> {
             Just(BoundaryMode::Planes(1.0)),
             Just(BoundaryMode::Locked)
         ],
-        any::<bool>(),
+        prop_oneof![
+            Just(PlacementMode::SolveFirst),
+            Just(PlacementMode::Optimal),
+            Just(PlacementMode::EndpointOrMidpoint)
+        ],
         prop_oneof![
             Just(Weighting::Area),
             Just(Weighting::Unweighted),
@@ -98,15 +102,11 @@ fn fast_options() -> impl Strategy<Value = SimplifyOptions> {
         prop::collection::vec(0..200u32, 0..4),
     )
         .prop_map(
-            |(r, boundary, midpoint, weighting, angle, sliver, locked)| {
+            |(r, boundary, placement, weighting, angle, sliver, locked)| {
                 SimplifyOptions::FAST
                     .with_target(Target::Ratio(r))
                     .with_boundary(boundary)
-                    .with_placement(if midpoint {
-                        PlacementMode::EndpointOrMidpoint
-                    } else {
-                        PlacementMode::Optimal
-                    })
+                    .with_placement(placement)
                     .with_weighting(weighting)
                     .with_max_normal_angle(angle)
                     .with_min_triangle_quality(sliver)

@@ -158,11 +158,14 @@ pub enum ContractionOrder {
     /// [`QuadricMode::Exact`], `orientation_check`, `preserve_topology` and a
     /// `pair_threshold` above zero with
     /// [`SimplifyError::NotInPasses`](super::SimplifyError::NotInPasses).
-    /// [`SimplifyOptions::FAST`] is the defaults with this order. With a
-    /// [`max_error`](SimplifyOptions::max_error) bound, no pair over the bound is
-    /// contracted, and the run stops with
+    /// [`SimplifyOptions::FAST`] is the defaults with this order, summed quadrics, no
+    /// orientation check and [`PlacementMode::SolveFirst`]. With a
+    /// [`max_error`](SimplifyOptions::max_error) bound, a pair over the bound is never
+    /// contracted but does not end the run either; the run stops with
     /// [`StopReason::MaxErrorReached`](super::StopReason::MaxErrorReached) when a pass
-    /// finds none under it.
+    /// contracts nothing and met at least one pair over the bound (and with
+    /// [`StopReason::NoValidPair`](super::StopReason::NoValidPair) when the checks
+    /// refused every pair under it).
     Passes,
 }
 
@@ -185,7 +188,8 @@ pub struct SimplifyOptions {
     pub target: Target,
     /// Stop before the first contraction whose error would exceed this distance (see
     /// [`SimplifyReport::max_error`](super::SimplifyReport::max_error) for what the
-    /// error measures). Default: `None`.
+    /// error measures); in [`ContractionOrder::Passes`], never contract a pair over it
+    /// (see there). Default: `None`.
     pub max_error: Option<Length>,
     /// Vertex pairs closer than this that share no edge are candidates too ("virtual
     /// pairs"), so separate parts can merge; zero means edges only. Ignored (no virtual

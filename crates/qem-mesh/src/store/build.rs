@@ -183,8 +183,13 @@ impl MeshStore {
 }
 
 /// Indices of the triangles to insert, in input order: no repeated index, and only the
-/// first triangle of each vertex set. Counts what it drops in `stats`.
-fn kept_triangles(triangles: &[[u32; 3]], vertex_count: usize, stats: &mut BuildStats) -> Vec<u32> {
+/// first triangle of each vertex set. Counts what it drops in `stats`. (The pass-based
+/// order keeps the same triangles.)
+pub(crate) fn kept_triangles(
+    triangles: &[[u32; 3]],
+    vertex_count: usize,
+    stats: &mut BuildStats,
+) -> Vec<u32> {
     // Each triangle's vertex set, sorted, in input order; repeated indices dropped.
     let sets: Vec<([u32; 3], u32)> = triangles
         .par_iter()

@@ -51,7 +51,7 @@ use std::marker::PhantomData;
 use slotmap::{Key, KeyData, SlotMap};
 use smallvec::SmallVec;
 
-mod build;
+pub(crate) mod build;
 mod compact;
 mod contract;
 mod fan;
