@@ -177,8 +177,14 @@ impl PassEngine {
             triangles: cleaned.triangles.clone(),
             // The triangles the store would keep: none with a repeated corner (it
             // would count as live while having no area), only the first of each
-            // vertex set. Cleaning drops them already unless its passes are off.
-            live: kept_triangles(&cleaned.triangles, n, &mut BuildStats::default()),
+            // vertex set. Cleaning has dropped both when its passes were on; the
+            // search (16 bytes a triangle, at the setup's memory peak) runs only when
+            // they were off.
+            live: if options.clean.drop_repeated_index && options.clean.drop_duplicates {
+                (0..cleaned.triangles.len() as u32).collect()
+            } else {
+                kept_triangles(&cleaned.triangles, n, &mut BuildStats::default())
+            },
             original_normals: Vec::new(),
             moved_in: vec![0; n],
             pass: 0,
