@@ -29,7 +29,7 @@ pub(super) enum Rejection {
 
 /// `4√3·area / (l₀² + l₁² + l₂²)` from twice the area (`double_area`): 1 for an
 /// equilateral triangle, 0 for a degenerate one.
-pub(super) fn quality(p0: DVec3, p1: DVec3, p2: DVec3, double_area: f64) -> f64 {
+fn quality(p0: DVec3, p1: DVec3, p2: DVec3, double_area: f64) -> f64 {
     let sum = p0.distance_squared(p1) + p1.distance_squared(p2) + p2.distance_squared(p0);
     if sum > 0.0 {
         2.0 * 3f64.sqrt() * double_area / sum
@@ -42,7 +42,7 @@ pub(super) fn quality(p0: DVec3, p1: DVec3, p2: DVec3, double_area: f64) -> f64 
 /// `min_cos`: `old·new < min_cos·|old|·|new|`, compared in squares (`new_squared` is
 /// `|new|²`) so that no square root is taken.
 #[inline]
-pub(super) fn turned_past(old: DVec3, new: DVec3, new_squared: f64, min_cos: f64) -> bool {
+fn turned_past(old: DVec3, new: DVec3, new_squared: f64, min_cos: f64) -> bool {
     let dot = old.dot(new);
     let bound = min_cos * min_cos * old.length_squared() * new_squared;
     if min_cos >= 0.0 {
@@ -64,6 +64,48 @@ pub(super) fn is_zero_area(
     squared.is_nan()
         || squared <= settings.min_double_area_squared
         || (settings.world_may_underflow && cross_underflows(world_corners))
+}
+
+/// The fold-over rules for one surviving face whose corners move from `old` to `new`
+/// (normalised frame), shared by both contraction orders: zero area (or NaN, only from
+/// overflow), a normal turned past the allowed angle or against the input face's
+/// (`input_normal`, asked only when the angle check is on), a sliver worse than before.
+/// `world_underflows` is asked only for a model so small that its cross products can
+/// underflow in world units (see `Settings::world_may_underflow`). Squared lengths
+/// throughout: no square root unless the sliver test runs.
+#[inline]
+pub(super) fn moved_face_verdict(
+    settings: &Settings,
+    old: [DVec3; 3],
+    new: [DVec3; 3],
+    input_normal: impl FnOnce() -> DVec3,
+    world_underflows: impl FnOnce() -> bool,
+) -> Result<(), Rejection> {
+    let new_normal = (new[1] - new[0]).cross(new[2] - new[0]);
+    let new_squared = new_normal.length_squared();
+    if new_squared.is_nan()
+        || new_squared <= settings.min_double_area_squared
+        || (settings.world_may_underflow && world_underflows())
+    {
+        return Err(Rejection::Degenerate);
+    }
+    let old_normal = (old[1] - old[0]).cross(old[2] - old[0]);
+    if let Some(min_cos) = settings.min_normal_cos {
+        // The second test stops a face from turning away from the input face it
+        // descends from in several small steps.
+        if turned_past(old_normal, new_normal, new_squared, min_cos)
+            || input_normal().dot(new_normal) < 0.0
+        {
+            return Err(Rejection::Flip);
+        }
+    }
+    if let Some(min_quality) = settings.min_quality {
+        let q_new = quality(new[0], new[1], new[2], new_squared.sqrt());
+        if q_new < min_quality && q_new < quality(old[0], old[1], old[2], old_normal.length()) {
+            return Err(Rejection::Sliver);
+        }
+    }
+    Ok(())
 }
 
 impl Engine {
@@ -156,8 +198,7 @@ impl Engine {
         around: &[Vec<FaceKey>; 2],
     ) -> Result<(), Rejection> {
         let moved = self.frame.to_normalized(world);
-        let mut verdict = Ok(());
-        'vertices: for faces in around {
+        for faces in around {
             for &f in faces {
                 let corners = self.store.face_vertices(f);
                 if corners.contains(&a) && corners.contains(&b) {
@@ -171,48 +212,24 @@ impl Engine {
                         old[i]
                     }
                 });
-                let new_normal = (new[1] - new[0]).cross(new[2] - new[0]);
-                // Squared lengths throughout: no square root unless the sliver test runs.
-                let new_squared = new_normal.length_squared();
-                // A NaN area (only from overflow) is refused too.
-                if new_squared.is_nan()
-                    || new_squared <= self.settings.min_double_area_squared
-                    || (self.settings.world_may_underflow
-                        && cross_underflows(corners.map(|c| {
+                moved_face_verdict(
+                    &self.settings,
+                    old,
+                    new,
+                    || *self.original_normals.get(f),
+                    || {
+                        cross_underflows(corners.map(|c| {
                             if c == a || c == b {
                                 world.to_array()
                             } else {
                                 self.store.position(c)
                             }
-                        })))
-                {
-                    verdict = Err(Rejection::Degenerate);
-                    break 'vertices;
-                }
-                let old_normal = (old[1] - old[0]).cross(old[2] - old[0]);
-                if let Some(min_cos) = self.settings.min_normal_cos {
-                    // The second test stops a face from turning away from the input face
-                    // it descends from in several small steps.
-                    let input_normal = *self.original_normals.get(f);
-                    if turned_past(old_normal, new_normal, new_squared, min_cos)
-                        || input_normal.dot(new_normal) < 0.0
-                    {
-                        verdict = Err(Rejection::Flip);
-                        break 'vertices;
-                    }
-                }
-                if let Some(min_quality) = self.settings.min_quality {
-                    let q_new = quality(new[0], new[1], new[2], new_squared.sqrt());
-                    if q_new < min_quality
-                        && q_new < quality(old[0], old[1], old[2], old_normal.length())
-                    {
-                        verdict = Err(Rejection::Sliver);
-                        break 'vertices;
-                    }
-                }
+                        }))
+                    },
+                )?;
             }
         }
-        verdict
+        Ok(())
     }
 
     /// Whether every face that contracting `b` into `a` at `world` moves faces the same

@@ -35,7 +35,7 @@
 //! few triangles there, and so only refuse more); every other vertex has the
 //! triangles it had at the pass's start, minus the removed ones.
 
-use super::checks::{quality, turned_past, Rejection};
+use super::checks::{moved_face_verdict, Rejection};
 use super::engine::{place_merged, Counters, Settings};
 use super::observer::{Contraction, Observer, Progress};
 use super::options::{BoundaryMode, SimplifyOptions};
@@ -747,38 +747,21 @@ impl PassEngine {
                     old[i]
                 }
             });
-            let new_normal = (new[1] - new[0]).cross(new[2] - new[0]);
-            let new_squared = new_normal.length_squared();
-            if new_squared.is_nan()
-                || new_squared <= self.settings.min_double_area_squared
-                || (self.settings.world_may_underflow
-                    && cross_underflows(corners.map(|c| {
+            moved_face_verdict(
+                &self.settings,
+                old,
+                new,
+                || self.original_normals[x.triangle as usize],
+                || {
+                    cross_underflows(corners.map(|c| {
                         if c == a || c == b {
                             world.to_array()
                         } else {
                             self.world[c as usize]
                         }
-                    })))
-            {
-                return Err(Rejection::Degenerate);
-            }
-            let old_normal = (old[1] - old[0]).cross(old[2] - old[0]);
-            if let Some(min_cos) = self.settings.min_normal_cos {
-                let input_normal = self.original_normals[x.triangle as usize];
-                if turned_past(old_normal, new_normal, new_squared, min_cos)
-                    || input_normal.dot(new_normal) < 0.0
-                {
-                    return Err(Rejection::Flip);
-                }
-            }
-            if let Some(min_quality) = self.settings.min_quality {
-                let q_new = quality(new[0], new[1], new[2], new_squared.sqrt());
-                if q_new < min_quality
-                    && q_new < quality(old[0], old[1], old[2], old_normal.length())
-                {
-                    return Err(Rejection::Sliver);
-                }
-            }
+                    }))
+                },
+            )?;
         }
         Ok(())
     }
