@@ -1,4 +1,4 @@
-//! The pass-based contraction order ([`ContractionOrder::Passes`]): flat arrays instead
+//! The pass-based contraction order ([`ContractionOrder::Passes`](super::ContractionOrder::Passes)): flat arrays instead
 //! of the store, and the cheapest pairs contracted in batches instead of one at a time.
 //!
 //! Each pass:
@@ -7,7 +7,8 @@
 //!    ends, so the results do not depend on the thread count; an edge whose ends did
 //!    not move in the last pass keeps its cost);
 //! 3. makes a batch of the cheapest edges, as many as the contractions still needed,
-//!    by (cost, index in the list), a total order;
+//!    by cost, ties broken by a scatter of the index in the list (a total order; see
+//!    [`scatter`] for why not the index itself);
 //! 4. contracts in rounds: each round takes the batch's *local minima*, the edges
 //!    that are the batch's cheapest at both of their ends (so no two share a vertex),
 //!    in list order (by first vertex, so the arrays are walked in order; the cheapest
@@ -16,12 +17,12 @@
 //!    and every edge at a moved vertex leave the batch, and the next round starts,
 //!    until the batch is empty or the target is reached.
 //!
-//! Why it is faster than [`ContractionOrder::Greedy`]: no heap and no store to keep
+//! Why it is faster than [`ContractionOrder::Greedy`](super::ContractionOrder::Greedy): no heap and no store to keep
 //! consistent, each edge costed at most once per pass, and the contractions walk the
 //! arrays in order. What it gives up: the strict greedy order (an edge whose cost fell
 //! during a pass waits for the next one), exact quadrics, virtual pairs, the
 //! orientation check and topology preservation (each refused with
-//! [`SimplifyError::NotInPasses`]).
+//! [`SimplifyError::NotInPasses`](super::SimplifyError::NotInPasses)).
 //!
 //! If a pass contracts nothing, its batch grows fourfold (without the pairs already
 //! refused) until every edge has been tried; a pass that still contracts nothing ends
