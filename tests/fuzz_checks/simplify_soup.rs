@@ -53,8 +53,9 @@ impl Lacking {
 /// count).
 ///
 /// The target kind is the low two bits of its byte. Bit 6 of that byte picks
-/// [`ContractionOrder::Passes`] (with summed quadrics, no orientation check and no
-/// virtual pairs, as in [`SimplifyOptions::FAST`]); with it, bit 7 asks for one option
+/// [`ContractionOrder::Passes`] (with summed quadrics, no orientation check, no
+/// virtual pairs and `SolveFirst` for the optimal placement, as in
+/// [`SimplifyOptions::FAST`]); with it, bit 7 asks for one option
 /// that order lacks, chosen by bits 2–3. No committed seed from before the pass-based
 /// order has bit 6 set, so each still decodes to the same greedy case.
 fn decode(data: &[u8]) -> (IndexedMesh, SimplifyOptions, Option<Lacking>) {
@@ -119,6 +120,11 @@ fn decode(data: &[u8]) -> (IndexedMesh, SimplifyOptions, Option<Lacking>) {
             .with_order(ContractionOrder::Passes)
             .with_quadrics(QuadricMode::Sum)
             .with_orientation_check(false);
+        // FAST's own placement unless the input asked for the ends and midpoint (the
+        // proptests of `passes_soups.rs` draw `Optimal` too).
+        if options.placement == PlacementMode::Optimal {
+            options = options.with_placement(PlacementMode::SolveFirst);
+        }
         match lacking {
             Some(Lacking::ExactQuadrics) => options = options.with_quadrics(QuadricMode::Exact),
             Some(Lacking::OrientationCheck) => options = options.with_orientation_check(true),
