@@ -8,12 +8,20 @@
 //! stale entries dropped at pop): the stale entries doubled the heap, every pop sifted
 //! through a heap far larger than the cache, and a periodic pass had to sweep them out.
 //!
-//! Pop order is fixed by the key alone, `(cost, a, b)` compared as (`f64::total_cmp`,
-//! then the two vertices' slot keys in `KeyData::as_ffi` order), where `a` is the vertex
-//! the latest push named first. Two live entries never have equal keys (one entry per
-//! pair), so the heap's layout, which depends on the order of pushes, updates and
-//! removals, cannot change which pair pops next. `b` is kept beside the entry's
-//! position rather than in the entry, and read only when cost and `a` tie.
+//! Pop order is fixed by the key alone, `(cost, stamp)` compared as (`f64::total_cmp`,
+//! then the stamp), where the stamp counts the pushes: among pairs of equal cost, the
+//! one queued or re-costed longest ago pops first. Two live entries never have equal
+//! stamps, so the heap's layout, which depends on the order of pushes, updates and
+//! removals, cannot change which pair pops next.
+//!
+//! Why first-in first-out on ties rather than by the vertices' names: ties are common
+//! exactly where the surface is flat (every pair inside a plane costs 0), and a fixed
+//! order by name let one vertex win every tie around it: it absorbed its neighbours one
+//! after another into a hub of 100 and more faces, whose re-costed pairs came straight
+//! back to the top of the queue to be refused by the fold-over check again. A flat
+//! 121x121 grid took 8.2 s (704,850 refusals for 13,122 contractions). A pair re-costed
+//! by a contraction now waits behind every older pair of its cost, so a flat region
+//! thins evenly, round after round, as a pass-based simplifier would thin it.
 //!
 //! The heap is 4-ary: half the levels of a binary heap, and the four children of a node
 //! fill exactly one cache line (16-byte entries, aligned), so a sift through a heap
@@ -111,30 +119,34 @@ fn cost_from_bits(bits: u64) -> f64 {
     }
 }
 
-/// One heap entry: the cost, the first vertex and the pair's id, 16 bytes, so that the
-/// four children of a node fill one cache line (see [`Line`]). The second vertex, only
-/// needed on a tie of the first two, is in the id's [`Slot`].
+/// One heap entry: the cost, the push's stamp and the pair's id, 16 bytes, so that the
+/// four children of a node fill one cache line (see [`Line`]). The two vertices are in
+/// the id's [`Slot`], read only at pop.
 #[derive(Clone, Copy, Debug, Default)]
 struct Entry {
     /// [`cost_bits`] of the cost.
     cost: u64,
-    /// The [`Numbering`] of the vertex the push named first.
-    first: u32,
+    /// When the entry was pushed: the queue's push counter at the time (see
+    /// [`PairQueue::next_stamp`]). Unique among live entries.
+    stamp: u32,
     /// The pair's id: an edge's slot index, or a virtual pair's id past the edges.
     id: u32,
 }
 
-/// What the queue keeps per id, 8 bytes: where its entry is and its second vertex.
+/// What the queue keeps per id, 12 bytes: where its entry is and its two vertices.
 #[derive(Clone, Copy, Debug)]
 struct Slot {
     /// Heap index of the entry, [`ABSENT`] when not queued.
     position: u32,
+    /// The [`Numbering`] of the vertex the push named first.
+    first: u32,
     /// The [`Numbering`] of the vertex the push named second.
     second: u32,
 }
 
 const NO_SLOT: Slot = Slot {
     position: ABSENT,
+    first: 0,
     second: 0,
 };
 
@@ -162,9 +174,8 @@ pub(crate) struct Popped {
 /// at `ARITY * i + 1 ..= ARITY * i + ARITY` (stored in [`Line`]s), with the heap index
 /// of every id.
 ///
-/// Vertices are compared by their [`Numbering`], whose order is the `as_ffi` order of
-/// the keys, so a pair's tie-break is one `u64` (the store gains no vertex while the
-/// queue lives, so the numbering stays valid).
+/// Vertices are kept as their [`Numbering`] (the store gains no vertex while the queue
+/// lives, so the numbering stays valid): 4 bytes instead of a key's 8.
 #[derive(Debug, Default)]
 pub(crate) struct PairQueue {
     /// The heap, three entries late (see [`Line`]).
@@ -173,8 +184,10 @@ pub(crate) struct PairQueue {
     len: usize,
     /// Position and second vertex of every id.
     slots: Vec<Slot>,
-    /// Vertex numbers for the tie-break.
+    /// Vertex numbers, to keep a pair's vertices in 4 bytes each.
     vertices: Numbering<VertexKey>,
+    /// The stamp the next push gets.
+    next_stamp: u32,
     /// The edge of each edge id (= its slot index, which is also its number here).
     edges: Numbering<EdgeKey>,
     /// Ids below this are edges.
@@ -204,6 +217,7 @@ impl PairQueue {
             len: 0,
             slots: vec![NO_SLOT; edge_slots],
             vertices: Numbering::new(store.vertices()),
+            next_stamp: 0,
             edges,
             edge_slots,
             virtual_ids: HashMap::new(),
@@ -240,10 +254,32 @@ impl PairQueue {
         if x.cost != y.cost {
             return x.cost < y.cost;
         }
-        if x.first != y.first {
-            return x.first < y.first;
+        x.stamp < y.stamp
+    }
+
+    /// A stamp later than every live entry's. When the counter runs out (after 2^32
+    /// pushes), the live entries are stamped again `0..len` in their order, which
+    /// keeps the order and frees the rest of the range.
+    fn stamp(&mut self) -> u32 {
+        if self.next_stamp == u32::MAX {
+            self.restamp();
         }
-        self.slots[x.id as usize].second < self.slots[y.id as usize].second
+        let stamp = self.next_stamp;
+        self.next_stamp += 1;
+        stamp
+    }
+
+    /// Stamps the live entries `0..len` in their stamp order. Costs are untouched and
+    /// the stamps' order is kept, so the heap stays valid where it is.
+    fn restamp(&mut self) {
+        let mut order: Vec<(u32, usize)> = (0..self.len).map(|i| (self.get(i).stamp, i)).collect();
+        order.sort_unstable();
+        for (new, &(_, i)) in order.iter().enumerate() {
+            let p = i + ARITY - 1;
+            // At most `len` ≤ u32::MAX - 1 live entries: ids are u32 and one is ABSENT.
+            self.lines[p / ARITY].0[p % ARITY].stamp = new as u32;
+        }
+        self.next_stamp = self.len as u32;
     }
 
     /// The id of the pair `a`–`b` joined by `edge`, or of the virtual pair `a`–`b`
@@ -273,11 +309,13 @@ impl PairQueue {
         let id = self.id(a, b, edge);
         let entry = Entry {
             cost: cost_bits(cost),
-            first: self.vertices.number(a),
+            stamp: self.stamp(),
             id,
         };
+        let (first, second) = (self.vertices.number(a), self.vertices.number(b));
         let slot = &mut self.slots[id as usize];
-        slot.second = self.vertices.number(b);
+        slot.first = first;
+        slot.second = second;
         match slot.position {
             ABSENT => {
                 self.len += 1;
@@ -312,10 +350,11 @@ impl PairQueue {
         }
         let top = self.get(0);
         self.remove_at(0);
+        let slot = self.slots[top.id as usize];
         Some(Popped {
             cost: cost_from_bits(top.cost),
-            a: self.vertices.key(top.first),
-            b: self.vertices.key(self.slots[top.id as usize].second),
+            a: self.vertices.key(slot.first),
+            b: self.vertices.key(slot.second),
             edge: ((top.id as usize) < self.edge_slots).then(|| self.edges.key(top.id)),
         })
     }
@@ -471,7 +510,7 @@ mod tests {
     }
 
     #[test]
-    fn pops_cheapest_first_with_key_tie_break() {
+    fn pops_cheapest_first_then_oldest_first() {
         let (store, v) = strip(2);
         let e = |a: usize, b: usize| store.find_edge(v[a], v[b]);
         let mut q = PairQueue::new(&store);
@@ -484,32 +523,69 @@ mod tests {
             .collect();
         assert_eq!(
             order,
-            vec![(0.5, v[3]), (1.0, v[1]), (1.0, v[2]), (2.0, v[0])]
+            vec![(0.5, v[3]), (1.0, v[2]), (1.0, v[1]), (2.0, v[0])]
         );
     }
 
+    /// A pair re-costed to the same cost goes behind the pairs of that cost that were
+    /// queued before its update: the tie-break that keeps a vertex from winning every
+    /// tie around it (see the module's doc).
+    #[test]
+    fn a_recosted_pair_waits_behind_older_ties() {
+        let (store, v) = strip(2);
+        let e = |a: usize, b: usize| store.find_edge(v[a], v[b]);
+        let mut q = PairQueue::new(&store);
+        q.push(0.0, v[0], v[1], e(0, 1));
+        q.push(0.0, v[1], v[2], e(1, 2));
+        q.push(0.0, v[2], v[3], e(2, 3));
+        q.push(0.0, v[0], v[1], e(0, 1));
+        let order: Vec<VertexKey> = std::iter::from_fn(|| q.pop()).map(|c| c.a).collect();
+        assert_eq!(order, vec![v[1], v[2], v[0]]);
+    }
+
+    /// Running out of stamps renumbers the live entries without changing their order.
+    #[test]
+    fn stamps_running_out_keep_the_order() {
+        let (store, _) = strip(6);
+        let edges: Vec<EdgeKey> = store.edges().collect();
+        let mut q = PairQueue::new(&store);
+        q.next_stamp = u32::MAX - 3;
+        // Costs 1, 0, 1, 0, ...: the ties must pop in push order across the wrap.
+        for (k, &edge) in edges.iter().enumerate() {
+            let [a, b] = store.edge_vertices(edge);
+            q.push((k % 2) as f64, a, b, Some(edge));
+        }
+        assert!(q.next_stamp < 100, "the stamps were renumbered");
+        let popped: Vec<EdgeKey> = std::iter::from_fn(|| q.pop())
+            .filter_map(|c| c.edge)
+            .collect();
+        let expected: Vec<EdgeKey> = (0..2)
+            .flat_map(|parity| edges.iter().skip(parity).step_by(2).copied())
+            .collect();
+        assert_eq!(popped, expected);
+    }
+
     /// Pushes (new pairs and updates, either way round), removals of edges and of
-    /// virtual pairs, and pops, against a model that keeps one `(cost, a, b)` per pair
-    /// and pops its smallest: every pop agrees, and so does the final length.
+    /// virtual pairs, and pops, against a model that keeps one `(cost, stamp, a, b)` per
+    /// pair (the stamp counting pushes) and pops the smallest `(cost, stamp)`: every pop
+    /// agrees, and so does the final length.
     #[test]
     fn matches_a_sorted_model_through_updates_and_removals() {
         let (store, v) = strip(60);
         let edges: Vec<EdgeKey> = store.edges().collect();
         let mut q = PairQueue::new(&store);
-        // Model: pair name -> (cost, a, b); a pair is an edge index or a virtual (i, j).
-        let mut model: std::collections::BTreeMap<
-            (usize, usize, bool),
-            (f64, VertexKey, VertexKey),
-        > = Default::default();
+        // Model: pair name -> (cost, push number, a, b); a pair is an edge index or a
+        // virtual (i, j).
+        type Name = (usize, usize, bool);
+        type Queued = (f64, u64, VertexKey, VertexKey);
+        let mut model: std::collections::BTreeMap<Name, Queued> = Default::default();
+        let mut pushes = 0u64;
         let mut seed = 12345u64;
         let mut next = || {
             seed = seed
                 .wrapping_mul(6364136223846793005)
                 .wrapping_add(1442695040888963407);
             (seed >> 33) as usize
-        };
-        let key = |c: &(f64, VertexKey, VertexKey)| {
-            (c.0.to_bits(), c.1.data().as_ffi(), c.2.data().as_ffi())
         };
         for _ in 0..5000 {
             match next() % 6 {
@@ -526,13 +602,15 @@ mod tests {
                             (v[j], v[i])
                         };
                         q.push(cost, a, b, None);
-                        model.insert((i.min(j), i.max(j), true), (cost, a, b));
+                        pushes += 1;
+                        model.insert((i.min(j), i.max(j), true), (cost, pushes, a, b));
                     } else {
                         let k = next() % edges.len();
                         let [x, y] = store.edge_vertices(edges[k]);
                         let (a, b) = if next() % 2 == 0 { (x, y) } else { (y, x) };
                         q.push(cost, a, b, Some(edges[k]));
-                        model.insert((k, 0, false), (cost, a, b));
+                        pushes += 1;
+                        model.insert((k, 0, false), (cost, pushes, a, b));
                     }
                 }
                 3 => {
@@ -548,17 +626,12 @@ mod tests {
                 _ => {
                     let expected = model
                         .iter()
-                        .min_by(|x, y| {
-                            x.1 .0
-                                .total_cmp(&y.1 .0)
-                                .then(key(x.1).1.cmp(&key(y.1).1))
-                                .then(key(x.1).2.cmp(&key(y.1).2))
-                        })
+                        .min_by(|x, y| x.1 .0.total_cmp(&y.1 .0).then(x.1 .1.cmp(&y.1 .1)))
                         .map(|(name, c)| (*name, *c));
                     let popped = q.pop();
                     match (expected, popped) {
                         (None, None) => {}
-                        (Some((name, (cost, a, b))), Some(p)) => {
+                        (Some((name, (cost, _, a, b))), Some(p)) => {
                             assert_eq!((p.cost, p.a, p.b), (cost, a, b));
                             let edge = (!name.2).then(|| edges[name.0]);
                             assert_eq!(p.edge, edge);

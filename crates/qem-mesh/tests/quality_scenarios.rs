@@ -64,10 +64,45 @@ fn flat_sheet_keeps_its_border_loop_and_area_with_border_planes() {
         "area {}",
         area(&out.mesh)
     );
-    // Without border planes the sheet shrinks at zero cost: the same run keeps a
-    // tenth of the area.
+    // Without border planes the border moves inward at zero cost: the same run loses
+    // about a quarter of the area (302 of 400 left).
     let free = simplify(&sheet, &at(0.1).with_boundary(BoundaryMode::Free)).unwrap();
-    assert!(area(&free.mesh) < 100.0, "area {}", area(&free.mesh));
+    assert!(area(&free.mesh) < 350.0, "area {}", area(&free.mesh));
+}
+
+/// The most faces around one vertex of `mesh`.
+fn max_valence(mesh: &IndexedMesh) -> usize {
+    let mut count = vec![0usize; mesh.vertex_count()];
+    for t in &mesh.triangles {
+        for &v in t {
+            count[v as usize] += 1;
+        }
+    }
+    count.into_iter().max().unwrap_or(0)
+}
+
+/// A flat region, where every pair costs exactly 0, thins evenly. With ties popped in
+/// the order of the vertices' names, one vertex won every tie around it and absorbed
+/// its neighbours into a hub (122 faces on a 120 x 120 grid), and the hub's re-costed
+/// pairs came back to the front only to be refused again: 704,850 fold-over refusals
+/// for 13,122 contractions, 8.2 s. The queue now pops ties first in, first out.
+#[test]
+fn flat_grid_thins_evenly_without_hubs() {
+    let sheet = grid(60, 60, 0.0);
+    let out = simplify(&sheet, &at(0.1)).unwrap();
+    assert_valid(&out.mesh, sheet.triangle_count());
+    assert_eq!(out.report.stop_reason, StopReason::TargetReached);
+    assert!(
+        max_valence(&out.mesh) <= 12,
+        "a hub of {} faces",
+        max_valence(&out.mesh)
+    );
+    assert!(
+        out.report.rejected_flip * 10 < out.report.edge_contractions,
+        "{} fold-over refusals for {} contractions",
+        out.report.rejected_flip,
+        out.report.edge_contractions
+    );
 }
 
 #[test]

@@ -765,7 +765,8 @@ impl Engine {
                 if why == Rejection::Orientation {
                     // Not refused for good: queued again at a penalty, so it is taken
                     // only when every alternative costs more (see ORIENTATION_PENALTY).
-                    // Same names in the same order: the tie-break stays the push's.
+                    // Same names in the same order, so the contraction keeps the
+                    // vertex it would have kept.
                     self.waive(a, b);
                     let floor = q.weight() * PENALTY_FLOOR_DISTANCE * PENALTY_FLOOR_DISTANCE;
                     self.queue.push(
