@@ -10,7 +10,8 @@
 //!   optimal placement, area weighting) and `Target::Triangles(target)`. The timed call
 //!   is the whole library call: validation, cleaning, store, quadrics, loop, compaction.
 //!   With `--fast`, `SimplifyOptions::FAST` instead (the pass-based order, summed
-//!   quadrics, no orientation check), reported as `qem --fast`.
+//!   quadrics, no orientation check), reported as `qem --fast`; with `--fast
+//!   --orientation-check`, FAST with the orientation check on.
 //! - meshopt: `meshopt::simplify` (meshoptimizer's `meshopt_simplify`, vendored by the
 //!   `meshopt` crate) on `f32` positions, with the target index count, no options and
 //!   a target error of `f32::MAX`, so that it stops on the count alone. Only the call is
@@ -82,10 +83,12 @@ struct Args {
     /// qem runs with `SimplifyOptions::FAST` (the pass-based order) instead of
     /// `DEFAULT`.
     fast: bool,
+    /// With `fast`, the orientation check on.
+    orientation_check: bool,
 }
 
 const USAGE: &str = "usage: versus [--input dragon|soup|sphere:N|PATH]... [--ratios R,R...] \
-                     [--runs K] [--tool both|qem|meshopt|none|prep] [--fast]";
+                     [--runs K] [--tool both|qem|meshopt|none|prep] [--fast [--orientation-check]]";
 
 fn parse_args() -> Result<Args, String> {
     let mut args = Args {
@@ -94,6 +97,7 @@ fn parse_args() -> Result<Args, String> {
         runs: 5,
         tools: Tools::Both,
         fast: false,
+        orientation_check: false,
     };
     let mut it = std::env::args().skip(1);
     while let Some(flag) = it.next() {
@@ -129,9 +133,13 @@ fn parse_args() -> Result<Args, String> {
                 }
             }
             "--fast" => args.fast = true,
+            "--orientation-check" => args.orientation_check = true,
             "-h" | "--help" => return Err(USAGE.to_string()),
             other => return Err(format!("unknown argument {other:?}\n{USAGE}")),
         }
+    }
+    if args.orientation_check && !args.fast {
+        return Err(format!("--orientation-check needs --fast\n{USAGE}"));
     }
     if args.inputs.is_empty() {
         args.inputs = vec!["dragon".into(), "sphere:4M".into(), "soup".into()];
@@ -300,9 +308,14 @@ fn medians(wall: &mut [f64], cpu: &mut [Option<f64>]) -> (f64, Option<f64>) {
     (median(wall), cpu.as_deref_mut().map(median))
 }
 
-fn run_qem(mesh: &IndexedMesh, target: usize, runs: usize, fast: bool) -> Result<Measured, String> {
-    let base = if fast {
-        SimplifyOptions::FAST
+fn run_qem(
+    mesh: &IndexedMesh,
+    target: usize,
+    runs: usize,
+    args: &Args,
+) -> Result<Measured, String> {
+    let base = if args.fast {
+        SimplifyOptions::FAST.with_orientation_check(args.orientation_check)
     } else {
         SimplifyOptions::DEFAULT
     };
@@ -426,7 +439,7 @@ fn run() -> Result<(), String> {
         for &ratio in &args.ratios {
             let target = (ratio * n as f64).floor() as usize;
             let qem = if args.tools.qem() {
-                Some(run_qem(&welded, target, args.runs, args.fast)?)
+                Some(run_qem(&welded, target, args.runs, &args)?)
             } else {
                 None
             };
@@ -435,7 +448,11 @@ fn run() -> Result<(), String> {
             } else {
                 None
             };
-            let qem_name = if args.fast { "qem --fast" } else { "qem" };
+            let qem_name = match (args.fast, args.orientation_check) {
+                (true, true) => "qem --fast --orientation-check",
+                (true, false) => "qem --fast",
+                _ => "qem",
+            };
             for (tool, m) in [(qem_name, &qem), ("meshopt", &meshopt)] {
                 let Some(m) = m else { continue };
                 let (versus, versus_cpu) = match (tool, &meshopt) {

@@ -27,7 +27,6 @@ const MAX_FACES: usize = 48;
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Lacking {
     ExactQuadrics,
-    OrientationCheck,
     PreserveTopology,
     PairThreshold,
 }
@@ -36,7 +35,6 @@ impl Lacking {
     fn name(self) -> &'static str {
         match self {
             Lacking::ExactQuadrics => "quadrics = Exact",
-            Lacking::OrientationCheck => "orientation_check = true",
             Lacking::PreserveTopology => "preserve_topology = true",
             Lacking::PairThreshold => "pair_threshold above zero (virtual pairs)",
         }
@@ -55,20 +53,24 @@ impl Lacking {
 /// The target kind is the low two bits of its byte. Bit 6 of that byte picks
 /// [`ContractionOrder::Passes`] (with summed quadrics, no orientation check, no
 /// virtual pairs and `SolveFirst` for the optimal placement, as in
-/// [`SimplifyOptions::FAST`]); with it, bit 7 asks for one option
-/// that order lacks, chosen by bits 2–3. No committed seed from before the pass-based
-/// order has bit 6 set, so each still decodes to the same greedy case.
+/// [`SimplifyOptions::FAST`]); with it, bit 7 and bits 2–3 pick one more option: the
+/// orientation check (bits 2–3 = 1), or one that order lacks (0: exact quadrics, 2:
+/// topology, 3: a pair threshold). No committed seed from before the pass-based order
+/// has bit 6 set, so each still decodes to the same greedy case.
 fn decode(data: &[u8]) -> (IndexedMesh, SimplifyOptions, Option<Lacking>) {
     let mut b = Bytes::new(data);
     let n = 3 + b.below(14);
     let kind = b.byte();
     let passes = kind & 0x40 != 0;
-    let lacking = (passes && kind & 0x80 != 0).then_some(match (kind >> 2) & 3 {
-        0 => Lacking::ExactQuadrics,
-        1 => Lacking::OrientationCheck,
-        2 => Lacking::PreserveTopology,
-        _ => Lacking::PairThreshold,
+    let asks = passes && kind & 0x80 != 0;
+    let orientation = asks && (kind >> 2) & 3 == 1;
+    let lacking = asks.then_some(match (kind >> 2) & 3 {
+        0 => Some(Lacking::ExactQuadrics),
+        1 => None,
+        2 => Some(Lacking::PreserveTopology),
+        _ => Some(Lacking::PairThreshold),
     });
+    let lacking = lacking.flatten();
     let target = match (kind % 4, b.byte()) {
         (0, x) => Target::Ratio(f64::from(x) / 255.0),
         (1, x) => Target::Triangles(usize::from(x)),
@@ -119,7 +121,7 @@ fn decode(data: &[u8]) -> (IndexedMesh, SimplifyOptions, Option<Lacking>) {
         options = options
             .with_order(ContractionOrder::Passes)
             .with_quadrics(QuadricMode::Sum)
-            .with_orientation_check(false);
+            .with_orientation_check(orientation);
         // FAST's own placement unless the input asked for the ends and midpoint (the
         // proptests of `passes_soups.rs` draw `Optimal` too).
         if options.placement == PlacementMode::Optimal {
@@ -127,7 +129,6 @@ fn decode(data: &[u8]) -> (IndexedMesh, SimplifyOptions, Option<Lacking>) {
         }
         match lacking {
             Some(Lacking::ExactQuadrics) => options = options.with_quadrics(QuadricMode::Exact),
-            Some(Lacking::OrientationCheck) => options = options.with_orientation_check(true),
             Some(Lacking::PreserveTopology) => options = options.with_preserve_topology(true),
             Some(Lacking::PairThreshold) => {} // as decoded, perhaps zero
             None => options = options.with_pair_threshold(Length::DiagonalFraction(0.0)),
@@ -271,8 +272,9 @@ mod tests {
     }
 
     /// The seeds from before the pass-based order still decode to greedy runs (the
-    /// format stayed compatible); those named `_passes` run in passes, and those named
-    /// `_refuses_` ask for the option they name and are refused with its name.
+    /// format stayed compatible); those named `_passes` run in passes (with the
+    /// orientation check when named `_orientation_check`), and those named `_refuses_`
+    /// ask for the option they name and are refused with its name.
     #[test]
     fn seeds_decode_to_the_order_their_name_says() {
         let seeds = seeds();
@@ -285,6 +287,11 @@ mod tests {
                 ContractionOrder::Greedy
             };
             assert_eq!(options.order, want, "{name}");
+            assert_eq!(
+                options.orientation_check,
+                want == ContractionOrder::Greedy || name.contains("_orientation_check"),
+                "{name}"
+            );
             // Only a seed that asks for a lacking option runs here (the replay test
             // runs them all through the whole check).
             let refused = match lacking.map(|_| simplify(&mesh, &options)) {
@@ -295,7 +302,6 @@ mod tests {
                 Some((_, what)) => {
                     let asked = match what {
                         "exact_quadrics" => Lacking::ExactQuadrics,
-                        "orientation_check" => Lacking::OrientationCheck,
                         "preserve_topology" => Lacking::PreserveTopology,
                         "pair_threshold" => Lacking::PairThreshold,
                         _ => panic!("{name}: refuses what?"),

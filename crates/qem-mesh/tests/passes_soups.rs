@@ -73,8 +73,8 @@ fn bumpy_grid(keep_all: bool) -> impl Strategy<Value = IndexedMesh> {
 
 /// FAST at a random ratio, with the other options the pass-based order implements
 /// varied: border handling, placement, weighting, normal-angle limit (the default
-/// most often), sliver limit and random locked vertices (some out of range of the
-/// smaller inputs, which must be the documented error).
+/// most often), sliver limit, the orientation check, and random locked vertices (some
+/// out of range of the smaller inputs, which must be the documented error).
 fn fast_options() -> impl Strategy<Value = SimplifyOptions> {
     (
         0.0..1.0f64,
@@ -100,9 +100,10 @@ fn fast_options() -> impl Strategy<Value = SimplifyOptions> {
         ],
         prop_oneof![Just(0.0), 0.0..0.5f64],
         prop::collection::vec(0..200u32, 0..4),
+        any::<bool>(),
     )
         .prop_map(
-            |(r, boundary, placement, weighting, angle, sliver, locked)| {
+            |(r, boundary, placement, weighting, angle, sliver, locked, orientation)| {
                 SimplifyOptions::FAST
                     .with_target(Target::Ratio(r))
                     .with_boundary(boundary)
@@ -111,6 +112,7 @@ fn fast_options() -> impl Strategy<Value = SimplifyOptions> {
                     .with_max_normal_angle(angle)
                     .with_min_triangle_quality(sliver)
                     .with_locked_vertices(locked)
+                    .with_orientation_check(orientation)
             },
         )
 }

@@ -1,7 +1,8 @@
 //! The pass-based order ([`SimplifyOptions::FAST`]) gives the same output, bit for bit,
 //! on rayon pools of 1, 2 and 3 threads.
 //!
-//! Its parallel parts: the input's normalisation and face planes in the setup, and the
+//! Its parallel parts: the input's normalisation and face planes in the setup (and,
+//! with the orientation check, the input's index, built meanwhile), and the
 //! costing of every edge in each pass (a parallel map, collected in order). The input
 //! has 157,410 edges, so in the first passes each thread of a larger pool costs tens of
 //! thousands of them: the split is real, not a formality of a tiny input.
@@ -58,15 +59,29 @@ fn noisy_grid() -> IndexedMesh {
 
 #[test]
 fn fast_simplification_is_the_same_on_1_2_and_3_threads() {
+    same_on_1_2_and_3_threads(&SimplifyOptions::FAST.with_target(Target::Ratio(0.05)));
+}
+
+/// With the orientation check, whose index is built on the other core while the
+/// quadrics are summed.
+#[test]
+fn fast_simplification_with_the_orientation_check_is_the_same_on_1_2_and_3_threads() {
+    same_on_1_2_and_3_threads(
+        &SimplifyOptions::FAST
+            .with_target(Target::Ratio(0.05))
+            .with_orientation_check(true),
+    );
+}
+
+fn same_on_1_2_and_3_threads(options: &SimplifyOptions) {
     let grid = noisy_grid();
     let edges = passes_common::edge_valences(&grid).len();
     assert!(edges >= 100_000, "{edges} edges");
-    let options = SimplifyOptions::FAST.with_target(Target::Ratio(0.05));
-    let one = on_threads(1, || simplify(&grid, &options)).expect("simplifies");
+    let one = on_threads(1, || simplify(&grid, options)).expect("simplifies");
     assert_eq!(one.report.stop_reason, StopReason::TargetReached);
     assert!(one.report.edge_contractions > 40_000);
     for threads in [2, 3] {
-        let many = on_threads(threads, || simplify(&grid, &options)).expect("simplifies");
+        let many = on_threads(threads, || simplify(&grid, options)).expect("simplifies");
         assert_eq!(bits(&many.mesh), bits(&one.mesh), "{threads} threads");
         let mut report = many.report.clone();
         report.timings = one.report.timings;

@@ -3,7 +3,7 @@
 
 use super::engine::{Engine, Settings};
 use crate::clean::cross_underflows;
-use crate::store::{EdgeClass, EdgeKey, FaceKey, VertexClass, VertexKey};
+use crate::store::{slot_index, EdgeClass, EdgeKey, FaceKey, VertexClass, VertexKey};
 use qem_core::{DVec3, Frame};
 
 /// Why a contraction was refused (each has a counter in the report).
@@ -262,7 +262,7 @@ impl Engine {
                         self.normalized_position(c)
                     }
                 });
-                if !surface.agrees(f, new, &mut neighbour_hint) {
+                if !surface.agrees(slot_index(f), new, &mut neighbour_hint) {
                     agree = false;
                     break 'vertices;
                 }

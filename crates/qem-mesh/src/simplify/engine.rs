@@ -6,6 +6,7 @@ use super::observer::{Contraction, Observer, Progress};
 use super::options::{BoundaryMode, PlacementMode, QuadricMode, SimplifyOptions, VirtualPairs};
 use super::orientation::InputSurface;
 use super::report::{SimplifyError, StopReason};
+use super::waivers::penalised;
 use crate::clean::min_double_area;
 use crate::pairs::grid::{virtual_pairs, GridOptions};
 use crate::queue::PairQueue;
@@ -36,14 +37,14 @@ const OBSERVER_INTERVAL: usize = 4096;
 /// 128 none is left at 0.1; at 0.01 the mannequin's Hausdorff is 4.1% (32) and 3.9%
 /// (128) against 2.0% with the check off, the other 0.01 runs within a few percent of
 /// each other. 32 is the smallest factor tried that leaves none at 0.1.
-const ORIENTATION_PENALTY: f64 = 32.0;
+pub(super) const ORIENTATION_PENALTY: f64 = 32.0;
 
 /// The least cost a penalised pair is queued at, as a distance (normalised units, where
 /// the model's diagonal is at most 2√3): `weight · d²` for the pair's quadric. Why: on a
 /// flat region a pair costs exactly 0, and 32 × 0 would queue it right back at the
 /// front, where it would pop again at once with the check waived; with the floor it
 /// waits behind every pair that moves the surface by less than this.
-const PENALTY_FLOOR_DISTANCE: f64 = 1e-6;
+pub(super) const PENALTY_FLOOR_DISTANCE: f64 = 1e-6;
 
 /// A pair's two vertices, smaller key first: one spelling per pair.
 fn ordered_pair(a: VertexKey, b: VertexKey) -> (VertexKey, VertexKey) {
@@ -768,9 +769,8 @@ impl Engine {
                     // Same names in the same order, so the contraction keeps the
                     // vertex it would have kept.
                     self.waive(a, b);
-                    let floor = q.weight() * PENALTY_FLOOR_DISTANCE * PENALTY_FLOOR_DISTANCE;
                     self.queue.push(
-                        placed.cost.max(floor) * ORIENTATION_PENALTY,
+                        penalised(placed.cost, &q),
                         candidate.a,
                         candidate.b,
                         candidate.edge,

@@ -25,6 +25,7 @@ mod options;
 mod orientation;
 mod passes;
 mod report;
+mod waivers;
 
 pub use observer::{Contraction, NoObserver, Observer, Progress};
 pub use options::{
@@ -35,7 +36,7 @@ pub use options::{
 pub use report::{Simplified, SimplifyError, SimplifyReport, StopReason, Timings};
 
 use crate::clean::{clean, CleanOptions, Cleaned};
-use crate::store::MeshStore;
+use crate::store::{slot_index, MeshStore};
 use crate::IndexedMesh;
 use engine::{Counters, Engine};
 use passes::PassEngine;
@@ -164,7 +165,18 @@ pub fn simplify_levels(
         ContractionOrder::Passes => {
             refuse_what_passes_lack(options, &frame)?;
             let clock = Instant::now();
-            let engine = PassEngine::new(&cleaned.mesh, frame, &locked, options);
+            // As in the greedy setup: the orientation check's index on the other core.
+            let (mut engine, input_surface) = rayon::join(
+                || PassEngine::new(&cleaned.mesh, frame, &locked, options),
+                || {
+                    options
+                        .orientation_check
+                        .then(|| orientation::InputSurface::new(&cleaned.mesh, &frame))
+                },
+            );
+            if let Some((surface, slots)) = input_surface {
+                engine.set_input_surface(surface, &slots);
+            }
             timings.setup = clock.elapsed();
             Run::Passes(engine)
         }
@@ -268,7 +280,11 @@ fn set_up_greedy(
     // The store makes one face per cleaned triangle, in order, when none is refused;
     // each face's search hint starts as its own triangle.
     engine.input_surface = input_surface.map(|(mut surface, slots)| {
-        surface.seed_hints(engine.store.faces(), engine.store.face_count(), &slots);
+        surface.seed_hints(
+            engine.store.faces().map(slot_index),
+            engine.store.face_count(),
+            &slots,
+        );
         surface
     });
     timings.setup = clock.elapsed();
@@ -280,8 +296,6 @@ fn set_up_greedy(
 fn refuse_what_passes_lack(options: &SimplifyOptions, frame: &Frame) -> Result<(), SimplifyError> {
     let lacking = if options.quadrics == QuadricMode::Exact {
         Some("quadrics = Exact")
-    } else if options.orientation_check {
-        Some("orientation_check = true")
     } else if options.preserve_topology {
         Some("preserve_topology = true")
     } else if options.pair_threshold.normalized(frame) > 0.0 {

@@ -17,7 +17,6 @@
 //! any of them faces away (normal dot product ≤ 0).
 
 use crate::measure::TriangleBvh;
-use crate::store::{FaceKey, SlotVec};
 use crate::IndexedMesh;
 use qem_core::{DVec3, Frame};
 
@@ -59,7 +58,10 @@ pub(super) struct InputSurface {
     /// from above, which is what the quick test needs (and lets the full test prune
     /// from its first node). Any triangle would give the same answers; a nearer one
     /// gives them sooner.
-    hints: SlotVec<FaceKey, u32>,
+    ///
+    /// Indexed by a face number the caller chooses: the slot index of a store face in
+    /// the greedy order, the triangle's index in the pass-based one.
+    hints: Vec<u32>,
 }
 
 impl InputSurface {
@@ -88,16 +90,16 @@ impl InputSurface {
         let surface = InputSurface {
             bvh,
             near: Vec::new(),
-            hints: SlotVec::for_keys(std::iter::empty(), NO_HINT),
+            hints: Vec::new(),
         };
         (surface, slots)
     }
 
     /// Gives each face its own input triangle as its first hint: `faces` lists the
-    /// store's `face_count` faces in the order of the cleaned mesh's triangles they
-    /// were made from, `slots` is what [`new`](Self::new) returned. When the two do
-    /// not correspond one to one (the store refused some triangle), no face gets a
-    /// hint yet.
+    /// numbers of the run's `face_count` faces (see `hints`) in the order of the
+    /// cleaned mesh's triangles they were made from, `slots` is what
+    /// [`new`](Self::new) returned. When the two do not correspond one to one (the
+    /// store refused some triangle), no face gets a hint yet.
     ///
     /// Why seed the hints: without one, a face's first test is a full nearest search
     /// (on the dragon at ratio 0.1, about 9 in 10 of the full searches). Any triangle
@@ -105,23 +107,26 @@ impl InputSurface {
     /// the face's own input triangle is the nearest one.
     pub fn seed_hints(
         &mut self,
-        faces: impl Iterator<Item = FaceKey> + Clone,
+        faces: impl Iterator<Item = usize> + Clone,
         face_count: usize,
         slots: &[u32],
     ) {
         if face_count != slots.len() {
             return;
         }
-        self.hints = SlotVec::for_keys(faces.clone(), NO_HINT);
+        // Sized from the numbers rather than grown (growing by doubling would hold up
+        // to twice the memory).
+        let len = faces.clone().map(|f| f + 1).max().unwrap_or(0);
+        self.hints = vec![NO_HINT; len];
         for (face, &slot) in faces.zip(slots) {
-            self.hints.set(face, slot);
+            self.hints[face] = slot;
         }
     }
 
     /// The hint of `face`, if it has one.
     #[inline]
-    fn hint(&self, face: FaceKey) -> Option<u32> {
-        Some(*self.hints.get(face)).filter(|&h| h != NO_HINT)
+    fn hint(&self, face: usize) -> Option<u32> {
+        self.hints.get(face).copied().filter(|&h| h != NO_HINT)
     }
 
     /// Whether face `face`, moved to these corners (normalised units), faces the same
@@ -136,7 +141,7 @@ impl InputSurface {
     #[inline]
     pub fn agrees(
         &mut self,
-        face: FaceKey,
+        face: usize,
         corners: [DVec3; 3],
         neighbour_hint: &mut Option<u32>,
     ) -> bool {
@@ -165,7 +170,10 @@ impl InputSurface {
             &mut self.near,
         );
         if let Some(t) = nearest {
-            self.hints.set(face, t);
+            if self.hints.len() <= face {
+                self.hints.resize(face + 1, NO_HINT);
+            }
+            self.hints[face] = t;
             *neighbour_hint = Some(t);
         }
         // A zero-area input triangle (cleaning drops exact ones) has no say.

@@ -20,9 +20,12 @@
 //! Why it is faster than [`ContractionOrder::Greedy`](super::ContractionOrder::Greedy): no heap and no store to keep
 //! consistent, each edge costed at most once per pass, and the contractions walk the
 //! arrays in order. What it gives up: the strict greedy order (an edge whose cost fell
-//! during a pass waits for the next one), exact quadrics, virtual pairs, the
-//! orientation check and topology preservation (each refused with
-//! [`SimplifyError::NotInPasses`](super::SimplifyError::NotInPasses)).
+//! during a pass waits for the next one), exact quadrics, virtual pairs and topology
+//! preservation (each refused with
+//! [`SimplifyError::NotInPasses`](super::SimplifyError::NotInPasses)). The
+//! orientation check runs last among the checks, as in the greedy loop; a pair it
+//! refuses is ranked at the greedy loop's penalty in later passes and then tried
+//! without it ([`super::waivers`]).
 //!
 //! If a pass contracts nothing, its batch grows fourfold (without the pairs already
 //! refused) until every edge has been tried; a pass that still contracts nothing ends
@@ -40,7 +43,9 @@ use super::checks::{moved_face_verdict, Rejection};
 use super::engine::{place_merged, Counters, Settings};
 use super::observer::{Contraction, Observer, Progress};
 use super::options::{BoundaryMode, SimplifyOptions};
+use super::orientation::InputSurface;
 use super::report::StopReason;
+use super::waivers::{penalised, Waivers};
 use crate::clean::cross_underflows;
 use crate::store::build::kept_triangles;
 use crate::store::BuildStats;
@@ -100,8 +105,9 @@ struct Around {
 
 /// Whether the pass ended for a reason that ends the run.
 enum PassEnd {
-    /// Ran out of candidates (or reached the target); `contracted` in this pass.
-    Done { contracted: usize },
+    /// Ran out of candidates (or reached the target); `contracted` in this pass, and
+    /// `waived` refused by the orientation check, to be tried without it next pass.
+    Done { contracted: usize, waived: usize },
     /// Nothing was contracted, and at least one candidate's error was above the
     /// bound.
     MaxErrorReached,
@@ -151,6 +157,10 @@ pub(super) struct PassEngine {
     seen_with: Vec<u32>,
     around: [Vec<Around>; 2],
     since_report: usize,
+    /// The input surface for the orientation check; `None` when the check is off.
+    input_surface: Option<InputSurface>,
+    /// Pairs refused by the orientation check, ranked at a penalty until tried again.
+    waivers: Waivers,
 }
 
 impl PassEngine {
@@ -203,6 +213,8 @@ impl PassEngine {
             seen_with: vec![u32::MAX; n],
             around: [Vec::new(), Vec::new()],
             since_report: 0,
+            input_surface: None,
+            waivers: Waivers::new(n),
             position,
         };
         let area_offset = engine.sum_face_planes(options);
@@ -216,6 +228,15 @@ impl PassEngine {
         engine.counters.locked_vertices = engine.locked.iter().filter(|&&l| l).count();
         engine.settings.any_locked = engine.counters.locked_vertices > 0;
         engine
+    }
+
+    /// Turns the orientation check on with `surface`, built from the same cleaned mesh
+    /// (`slots` as [`InputSurface::new`] returned them): each triangle's first hint is
+    /// its own input triangle.
+    pub fn set_input_surface(&mut self, mut surface: InputSurface, slots: &[u32]) {
+        let count = self.triangles.len();
+        surface.seed_hints(0..count, count, slots);
+        self.input_surface = Some(surface);
     }
 
     /// The corners of triangle `t` in the normalised frame.
@@ -381,7 +402,11 @@ impl PassEngine {
                 break StopReason::TargetReached;
             }
             match self.pass(target, start, observer) {
-                PassEnd::Done { contracted: 0 } => break StopReason::NoValidPair,
+                // A pair waived in this pass is tried without the check in the next.
+                PassEnd::Done {
+                    contracted: 0,
+                    waived: 0,
+                } => break StopReason::NoValidPair,
                 PassEnd::Done { .. } => {}
                 PassEnd::MaxErrorReached => break StopReason::MaxErrorReached,
                 PassEnd::Cancelled => break StopReason::Cancelled,
@@ -411,6 +436,7 @@ impl PassEngine {
         let mut take = needed.div_ceil(2).clamp(1, edges.max(1));
         let mut live_count = self.live.len();
         let mut contracted = 0;
+        let mut waived = 0;
         let mut end = None;
         let mut over_bound = false;
         let mut selected = std::mem::take(&mut self.selected);
@@ -458,6 +484,7 @@ impl PassEngine {
                         contracted += 1;
                     }
                     Attempt::Refused => {}
+                    Attempt::Waived => waived += 1,
                     // Never contracted; the pass goes on with the pairs under the bound.
                     Attempt::OverErrorBound => over_bound = true,
                 }
@@ -494,8 +521,8 @@ impl PassEngine {
         self.drop_removed();
         match end {
             Some(end) => end,
-            None if contracted == 0 && over_bound => PassEnd::MaxErrorReached,
-            None => PassEnd::Done { contracted },
+            None if contracted == 0 && waived == 0 && over_bound => PassEnd::MaxErrorReached,
+            None => PassEnd::Done { contracted, waived },
         }
     }
 
@@ -604,8 +631,15 @@ impl PassEngine {
         for (c, cost) in self.candidates.iter_mut().zip(costs) {
             c.cost = cost;
         }
+        // The unpenalised costs are the ones a later pass may reuse.
         self.last_listed.clone_from(&self.candidates);
         std::mem::swap(&mut self.last_listed_first, &mut self.listed_first);
+        for c in &mut self.candidates {
+            if self.waivers.contains(c.a, c.b) {
+                let q = self.quadric[c.a as usize] + self.quadric[c.b as usize];
+                c.cost = penalised(c.cost, &q);
+            }
+        }
     }
 
     /// The cost of the edge `a b` (`a < b`) in the last pass's list, when neither end
@@ -697,7 +731,18 @@ impl PassEngine {
             self.counters.reject(why);
             return Attempt::Refused;
         }
+        // Last, as in the greedy loop: the only check that searches outside the
+        // neighbourhood. A waived pair (refused before, ranked at a penalty since) is
+        // taken without it.
+        let waived = self.waivers.take(a, b);
+        if !waived && !self.faces_agree_with_input(a, b, world, around) {
+            self.counters.reject(Rejection::Orientation);
+            self.waivers.waive(a, b);
+            return Attempt::Waived;
+        }
         // The contraction itself.
+        self.waivers.forget(a);
+        self.waivers.forget(b);
         self.moved_in[a as usize] = self.pass;
         self.moved_in[b as usize] = self.pass;
         self.position[a as usize] = self.frame.to_normalized(world);
@@ -795,6 +840,39 @@ impl PassEngine {
         Ok(())
     }
 
+    /// Whether every triangle that contracting `b` into `a` at `world` moves faces the
+    /// same way as the input surface nearest to its new centroid (see
+    /// [`super::orientation`]); true when the check is off. Triangles on both `a` and
+    /// `b` collapse and are not asked.
+    fn faces_agree_with_input(
+        &mut self,
+        a: u32,
+        b: u32,
+        world: DVec3,
+        around: &[Vec<Around>; 2],
+    ) -> bool {
+        let Some(surface) = self.input_surface.as_mut() else {
+            return true;
+        };
+        let moved = self.frame.to_normalized(world);
+        // A triangle seen for the first time borrows the hint of the one checked before.
+        let mut neighbour_hint = None;
+        around.iter().flatten().all(|x| {
+            let corners = x.corners;
+            if corners.contains(&a) && corners.contains(&b) {
+                return true;
+            }
+            let new = corners.map(|c| {
+                if c == a || c == b {
+                    moved
+                } else {
+                    self.position[c as usize]
+                }
+            });
+            surface.agrees(x.triangle as usize, new, &mut neighbour_hint)
+        })
+    }
+
     /// Whether contracting `b` into `a` would leave a locked vertex without a triangle:
     /// `a` itself, or a locked common neighbour whose triangles all collapse or merge.
     /// A neighbour that moved in this pass may list too few triangles, which can only
@@ -873,6 +951,9 @@ enum Attempt {
     Contracted { removed: usize },
     /// Refused by a check (counted) or to keep the last triangles.
     Refused,
+    /// Refused by the orientation check (counted), and waived: ranked at a penalty
+    /// next pass, and tried then without the check.
+    Waived,
     /// The pair's error is above the bound: not contracted.
     OverErrorBound,
 }

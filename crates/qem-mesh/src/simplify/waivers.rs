@@ -1,0 +1,134 @@
+//! The orientation waivers of the pass-based order: pairs refused by the orientation
+//! check, costed at a penalty until one of their ends moves, and tried once more
+//! without the check.
+//!
+//! The greedy loop queues such a pair again at [`ORIENTATION_PENALTY`] times its cost
+//! and waives the check when it pops (see `Engine::waive`); the pass-based order has no
+//! queue, so it keeps the same facts here: which pairs are waived, so that each pass
+//! costs them at the penalty and their next attempt skips the check. A waiver ends when
+//! the pair is tried again or when either end moves (the greedy loop re-costs every pair
+//! of a moved vertex, which ends its waivers the same way).
+//!
+//! Why a flag per vertex beside the map: every edge of every pass asks whether it is
+//! waived, and once a pair has been refused the map is never empty again; the flags,
+//! one byte per vertex, answer no without hashing for almost every edge. The map is
+//! only looked up and changed, never iterated, so its order cannot reach an output.
+
+use super::engine::{ORIENTATION_PENALTY, PENALTY_FLOOR_DISTANCE};
+use qem_core::Quadric;
+use smallvec::SmallVec;
+use std::collections::HashMap;
+
+/// The waived pairs of a pass-based run, by vertex index.
+#[derive(Debug, Default)]
+pub(super) struct Waivers {
+    /// Whether each vertex may be in a waived pair (set when it is, cleared when its
+    /// waivers end; a cleared flag is always right, a set one only asks the map).
+    flagged: Vec<bool>,
+    /// Each vertex's waived partners, both ways round.
+    partners: HashMap<u32, SmallVec<[u32; 4]>>,
+}
+
+impl Waivers {
+    /// No waived pair among `vertex_count` vertices.
+    pub fn new(vertex_count: usize) -> Self {
+        Waivers {
+            flagged: vec![false; vertex_count],
+            partners: HashMap::new(),
+        }
+    }
+
+    /// Whether the pair `a`, `b` is waived.
+    #[inline]
+    pub fn contains(&self, a: u32, b: u32) -> bool {
+        self.flagged[a as usize]
+            && self.flagged[b as usize]
+            && self.partners.get(&a).is_some_and(|p| p.contains(&b))
+    }
+
+    /// Waives the pair `a`, `b` (refused by the orientation check).
+    pub fn waive(&mut self, a: u32, b: u32) {
+        if self.contains(a, b) {
+            return;
+        }
+        for (v, w) in [(a, b), (b, a)] {
+            self.flagged[v as usize] = true;
+            self.partners.entry(v).or_default().push(w);
+        }
+    }
+
+    /// Ends the waiver of the pair `a`, `b`; whether it was waived.
+    pub fn take(&mut self, a: u32, b: u32) -> bool {
+        if !self.contains(a, b) {
+            return false;
+        }
+        for (v, w) in [(a, b), (b, a)] {
+            self.drop_partner(v, w);
+        }
+        true
+    }
+
+    /// Ends every waiver of `v` (it moved or was removed).
+    pub fn forget(&mut self, v: u32) {
+        if !self.flagged[v as usize] {
+            return;
+        }
+        self.flagged[v as usize] = false;
+        if let Some(partners) = self.partners.remove(&v) {
+            for w in partners {
+                self.drop_partner(w, v);
+            }
+        }
+    }
+
+    /// Takes `w` off the partners of `v`, clearing `v`'s flag when none is left.
+    fn drop_partner(&mut self, v: u32, w: u32) {
+        if let Some(list) = self.partners.get_mut(&v) {
+            list.retain(|x| *x != w);
+            if list.is_empty() {
+                self.partners.remove(&v);
+                self.flagged[v as usize] = false;
+            }
+        }
+    }
+}
+
+/// The cost a waived pair is ranked at: the greedy loop's penalty on its cost `cost`
+/// (at least the floor of [`PENALTY_FLOOR_DISTANCE`] for its merged quadric `q`).
+pub(super) fn penalised(cost: f64, q: &Quadric) -> f64 {
+    let floor = q.weight() * PENALTY_FLOOR_DISTANCE * PENALTY_FLOOR_DISTANCE;
+    cost.max(floor) * ORIENTATION_PENALTY
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn waivers_end_when_taken_or_when_an_end_moves() {
+        let mut w = Waivers::new(6);
+        assert!(!w.contains(0, 1));
+        w.waive(0, 1);
+        w.waive(1, 2);
+        w.waive(3, 4);
+        assert!(w.contains(1, 0) && w.contains(2, 1) && w.contains(4, 3));
+        assert!(!w.contains(0, 2), "both flagged, not partners");
+        assert!(w.take(1, 0));
+        assert!(!w.take(0, 1), "taken once");
+        assert!(!w.flagged[0], "no waiver of 0 is left");
+        w.forget(2);
+        assert!(!w.contains(1, 2));
+        assert!(!w.flagged[1] && !w.flagged[2]);
+        assert!(w.contains(3, 4), "other pairs keep theirs");
+        w.forget(5);
+        assert!(w.contains(3, 4));
+    }
+
+    #[test]
+    fn a_zero_cost_is_penalised_from_the_floor() {
+        let q = Quadric::from_plane(qem_core::DVec3::Z, 0.0);
+        let floor = q.weight() * 1e-12;
+        assert_eq!(penalised(0.0, &q), floor * ORIENTATION_PENALTY);
+        assert_eq!(penalised(1.0, &q), ORIENTATION_PENALTY);
+    }
+}
