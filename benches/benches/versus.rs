@@ -10,8 +10,8 @@
 //!   optimal placement, area weighting) and `Target::Triangles(target)`. The timed call
 //!   is the whole library call: validation, cleaning, store, quadrics, loop, compaction.
 //!   With `--fast`, `SimplifyOptions::FAST` instead (the pass-based order, summed
-//!   quadrics, no orientation check), reported as `qem --fast`; with `--fast
-//!   --orientation-check`, FAST with the orientation check on.
+//!   quadrics, no orientation check), reported as `qem --fast`; `--orientation-check`
+//!   and `--exact` (with `--fast`) turn on the orientation check and exact quadrics.
 //! - meshopt: `meshopt::simplify` (meshoptimizer's `meshopt_simplify`, vendored by the
 //!   `meshopt` crate) on `f32` positions, with the target index count, no options and
 //!   a target error of `f32::MAX`, so that it stops on the count alone. Only the call is
@@ -45,7 +45,7 @@
 //! mesh, the two phases before the quadrics, apart.
 
 use qem_mesh::clean::{clean, CleanOptions};
-use qem_mesh::simplify::{simplify, SimplifyOptions, Target};
+use qem_mesh::simplify::{simplify, QuadricMode, SimplifyOptions, Target};
 use qem_mesh::{IndexedMesh, MeshStore};
 use std::collections::HashMap;
 use std::path::PathBuf;
@@ -85,10 +85,12 @@ struct Args {
     fast: bool,
     /// With `fast`, the orientation check on.
     orientation_check: bool,
+    /// With `fast`, exact quadrics.
+    exact: bool,
 }
 
 const USAGE: &str = "usage: versus [--input dragon|soup|sphere:N|PATH]... [--ratios R,R...] \
-                     [--runs K] [--tool both|qem|meshopt|none|prep] [--fast [--orientation-check]]";
+                     [--runs K] [--tool both|qem|meshopt|none|prep] [--fast [--orientation-check] [--exact]]";
 
 fn parse_args() -> Result<Args, String> {
     let mut args = Args {
@@ -98,6 +100,7 @@ fn parse_args() -> Result<Args, String> {
         tools: Tools::Both,
         fast: false,
         orientation_check: false,
+        exact: false,
     };
     let mut it = std::env::args().skip(1);
     while let Some(flag) = it.next() {
@@ -134,12 +137,15 @@ fn parse_args() -> Result<Args, String> {
             }
             "--fast" => args.fast = true,
             "--orientation-check" => args.orientation_check = true,
+            "--exact" => args.exact = true,
             "-h" | "--help" => return Err(USAGE.to_string()),
             other => return Err(format!("unknown argument {other:?}\n{USAGE}")),
         }
     }
-    if args.orientation_check && !args.fast {
-        return Err(format!("--orientation-check needs --fast\n{USAGE}"));
+    if (args.orientation_check || args.exact) && !args.fast {
+        return Err(format!(
+            "--orientation-check and --exact need --fast\n{USAGE}"
+        ));
     }
     if args.inputs.is_empty() {
         args.inputs = vec!["dragon".into(), "sphere:4M".into(), "soup".into()];
@@ -315,7 +321,13 @@ fn run_qem(
     args: &Args,
 ) -> Result<Measured, String> {
     let base = if args.fast {
-        SimplifyOptions::FAST.with_orientation_check(args.orientation_check)
+        SimplifyOptions::FAST
+            .with_orientation_check(args.orientation_check)
+            .with_quadrics(if args.exact {
+                QuadricMode::Exact
+            } else {
+                QuadricMode::Sum
+            })
     } else {
         SimplifyOptions::DEFAULT
     };
@@ -448,10 +460,12 @@ fn run() -> Result<(), String> {
             } else {
                 None
             };
-            let qem_name = match (args.fast, args.orientation_check) {
-                (true, true) => "qem --fast --orientation-check",
-                (true, false) => "qem --fast",
-                _ => "qem",
+            let qem_name = match (args.fast, args.orientation_check, args.exact) {
+                (false, ..) => "qem",
+                (true, false, false) => "qem --fast",
+                (true, true, false) => "qem --fast --orientation-check",
+                (true, false, true) => "qem --fast --exact",
+                (true, true, true) => "qem --fast --exact --orientation-check",
             };
             for (tool, m) in [(qem_name, &qem), ("meshopt", &meshopt)] {
                 let Some(m) = m else { continue };

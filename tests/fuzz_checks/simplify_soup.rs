@@ -26,7 +26,6 @@ const MAX_FACES: usize = 48;
 /// [`SimplifyError::NotInPasses`] must give.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Lacking {
-    ExactQuadrics,
     PreserveTopology,
     PairThreshold,
 }
@@ -34,7 +33,6 @@ enum Lacking {
 impl Lacking {
     fn name(self) -> &'static str {
         match self {
-            Lacking::ExactQuadrics => "quadrics = Exact",
             Lacking::PreserveTopology => "preserve_topology = true",
             Lacking::PairThreshold => "pair_threshold above zero (virtual pairs)",
         }
@@ -53,8 +51,8 @@ impl Lacking {
 /// The target kind is the low two bits of its byte. Bit 6 of that byte picks
 /// [`ContractionOrder::Passes`] (with summed quadrics, no orientation check, no
 /// virtual pairs and `SolveFirst` for the optimal placement, as in
-/// [`SimplifyOptions::FAST`]); with it, bit 7 and bits 2–3 pick one more option: the
-/// orientation check (bits 2–3 = 1), or one that order lacks (0: exact quadrics, 2:
+/// [`SimplifyOptions::FAST`]); with it, bit 7 and bits 2–3 pick one more option: exact
+/// quadrics (bits 2–3 = 0), the orientation check (1), or one that order lacks (2:
 /// topology, 3: a pair threshold). No committed seed from before the pass-based order
 /// has bit 6 set, so each still decodes to the same greedy case.
 fn decode(data: &[u8]) -> (IndexedMesh, SimplifyOptions, Option<Lacking>) {
@@ -63,10 +61,10 @@ fn decode(data: &[u8]) -> (IndexedMesh, SimplifyOptions, Option<Lacking>) {
     let kind = b.byte();
     let passes = kind & 0x40 != 0;
     let asks = passes && kind & 0x80 != 0;
+    let exact_quadrics = asks && (kind >> 2) & 3 == 0;
     let orientation = asks && (kind >> 2) & 3 == 1;
     let lacking = asks.then_some(match (kind >> 2) & 3 {
-        0 => Some(Lacking::ExactQuadrics),
-        1 => None,
+        0 | 1 => None,
         2 => Some(Lacking::PreserveTopology),
         _ => Some(Lacking::PairThreshold),
     });
@@ -120,7 +118,11 @@ fn decode(data: &[u8]) -> (IndexedMesh, SimplifyOptions, Option<Lacking>) {
     if passes {
         options = options
             .with_order(ContractionOrder::Passes)
-            .with_quadrics(QuadricMode::Sum)
+            .with_quadrics(if exact_quadrics {
+                QuadricMode::Exact
+            } else {
+                QuadricMode::Sum
+            })
             .with_orientation_check(orientation);
         // FAST's own placement unless the input asked for the ends and midpoint (the
         // proptests of `passes_soups.rs` draw `Optimal` too).
@@ -128,7 +130,6 @@ fn decode(data: &[u8]) -> (IndexedMesh, SimplifyOptions, Option<Lacking>) {
             options = options.with_placement(PlacementMode::SolveFirst);
         }
         match lacking {
-            Some(Lacking::ExactQuadrics) => options = options.with_quadrics(QuadricMode::Exact),
             Some(Lacking::PreserveTopology) => options = options.with_preserve_topology(true),
             Some(Lacking::PairThreshold) => {} // as decoded, perhaps zero
             None => options = options.with_pair_threshold(Length::DiagonalFraction(0.0)),
@@ -273,8 +274,9 @@ mod tests {
 
     /// The seeds from before the pass-based order still decode to greedy runs (the
     /// format stayed compatible); those named `_passes` run in passes (with the
-    /// orientation check when named `_orientation_check`), and those named `_refuses_`
-    /// ask for the option they name and are refused with its name.
+    /// orientation check when named `_orientation_check`, with exact quadrics when
+    /// named `_exact_quadrics`), and those named `_refuses_` ask for the option they
+    /// name and are refused with its name.
     #[test]
     fn seeds_decode_to_the_order_their_name_says() {
         let seeds = seeds();
@@ -292,6 +294,10 @@ mod tests {
                 want == ContractionOrder::Greedy || name.contains("_orientation_check"),
                 "{name}"
             );
+            if want == ContractionOrder::Passes {
+                let exact = options.quadrics == QuadricMode::Exact;
+                assert_eq!(exact, name.contains("_exact_quadrics"), "{name}");
+            }
             // Only a seed that asks for a lacking option runs here (the replay test
             // runs them all through the whole check).
             let refused = match lacking.map(|_| simplify(&mesh, &options)) {
@@ -301,7 +307,6 @@ mod tests {
             match name.split_once("_refuses_") {
                 Some((_, what)) => {
                     let asked = match what {
-                        "exact_quadrics" => Lacking::ExactQuadrics,
                         "preserve_topology" => Lacking::PreserveTopology,
                         "pair_threshold" => Lacking::PairThreshold,
                         _ => panic!("{name}: refuses what?"),

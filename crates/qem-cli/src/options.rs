@@ -95,16 +95,16 @@ pub struct SimplifyFlags {
     #[arg(long)]
     pub preserve_topology: bool,
     /// Contract in passes over flat arrays instead of one pair at a time: several
-    /// times faster, a little less accurate. Uses summed quadrics, no orientation
-    /// check (unless --orientation-check), and the 3x3 solve's point without
-    /// comparing it with the segment's.
-    /// Cannot be combined with --quadrics or --preserve-topology, nor with a
-    /// --pair-threshold above 0 (refused when the run starts) [default: off].
-    #[arg(long, conflicts_with_all = ["quadrics", "preserve_topology"])]
+    /// times faster, a little less accurate. Uses summed quadrics (unless --quadrics
+    /// exact), no orientation check (unless --orientation-check), and the 3x3 solve's
+    /// point without comparing it with the segment's.
+    /// Cannot be combined with --preserve-topology, nor with a --pair-threshold above 0
+    /// (refused when the run starts) [default: off].
+    #[arg(long, conflicts_with = "preserve_topology")]
     pub fast: bool,
-    /// Quadric of a contracted pair.
-    #[arg(long, value_enum, default_value_t = QuadricsFlag::Exact)]
-    pub quadrics: QuadricsFlag,
+    /// Quadric of a contracted pair [default: exact, or sum with --fast].
+    #[arg(long, value_enum)]
+    pub quadrics: Option<QuadricsFlag>,
     /// How face planes are weighted in the quadrics: `area` (by triangle area),
     /// `unweighted` (weight 1 each) or `mixed:S` (area + S × the mean face area; S = 0
     /// is `area`, large S tends to `unweighted`).
@@ -243,15 +243,15 @@ impl SimplifyFlags {
             .with_min_triangle_quality(self.min_quality)
             .with_orientation_check(!self.no_orientation_check)
             .with_preserve_topology(self.preserve_topology)
-            .with_quadrics(match self.quadrics {
-                QuadricsFlag::Sum => QuadricMode::Sum,
-                QuadricsFlag::Exact => QuadricMode::Exact,
-            })
             .with_weighting(self.weighting);
+        let quadrics = match (self.quadrics, self.fast) {
+            (Some(QuadricsFlag::Sum), _) | (None, true) => QuadricMode::Sum,
+            (Some(QuadricsFlag::Exact), _) | (None, false) => QuadricMode::Exact,
+        };
+        let options = options.with_quadrics(quadrics);
         let options = if self.fast {
             options
                 .with_order(ContractionOrder::Passes)
-                .with_quadrics(QuadricMode::Sum)
                 .with_orientation_check(self.orientation_check)
                 .with_placement(PlacementMode::SolveFirst)
         } else {
@@ -338,9 +338,18 @@ mod tests {
             .options()
             .expect("no lock file");
         assert_eq!(options, SimplifyOptions::FAST);
-        for flag in [&["--quadrics", "sum"][..], &["--preserve-topology"]] {
-            let args = ["qem", "--fast"].iter().chain(flag);
-            assert!(Cli::try_parse_from(args).is_err(), "--fast with {flag:?}");
+        let args = ["qem", "--fast", "--preserve-topology"];
+        assert!(
+            Cli::try_parse_from(args).is_err(),
+            "--fast with --preserve-topology"
+        );
+        // --quadrics exact gives exact quadrics in passes; sum is FAST's own.
+        for (flag, quadrics) in [("exact", QuadricMode::Exact), ("sum", QuadricMode::Sum)] {
+            let options = Cli::parse_from(["qem", "--fast", "--quadrics", flag])
+                .flags
+                .options()
+                .expect("no lock file");
+            assert_eq!(options, SimplifyOptions::FAST.with_quadrics(quadrics));
         }
         // --orientation-check keeps the check with --fast, and means nothing without it.
         let options = Cli::parse_from(["qem", "--fast", "--orientation-check"])

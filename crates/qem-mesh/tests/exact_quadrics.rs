@@ -2,7 +2,8 @@
 //! quadric must be the sum of the planes whose support meets the union of the two
 //! vertex groups, each plane once, and its cost the brute-force sum of squared plane
 //! distances at the chosen point — through whole simplifications, virtual pairs
-//! included.
+//! included, in both contraction orders (the pass-based one keeps its planes
+//! differently, see `simplify/pass_exact.rs`).
 //!
 //! The observer rebuilds the plane set from the cleaned mesh the engine reports, in the
 //! frame it reports: one plane per face (support: its three corners) and, with border
@@ -20,8 +21,8 @@ use common::{concat, grid};
 use proptest::prelude::*;
 use qem_core::{DVec3, Frame, Quadric};
 use qem_mesh::simplify::{
-    simplify_observed, BoundaryMode, Contraction, Length, Observer, QuadricMode, SimplifyOptions,
-    Target, Weighting,
+    simplify_observed, BoundaryMode, Contraction, ContractionOrder, Length, Observer, QuadricMode,
+    SimplifyOptions, Target, Weighting,
 };
 use qem_mesh::IndexedMesh;
 use std::collections::HashMap;
@@ -210,6 +211,32 @@ fn bumpy_grid_with_borders_matches_brute_force_to_the_end() {
     );
 }
 
+/// [`SimplifyOptions::FAST`] with exact quadrics down to `target`.
+fn exact_passes(target: f64) -> SimplifyOptions {
+    SimplifyOptions::FAST
+        .with_quadrics(QuadricMode::Exact)
+        .with_target(Target::Ratio(target))
+}
+
+#[test]
+fn bumpy_grid_with_borders_matches_brute_force_to_the_end_in_passes() {
+    let mesh = grid(12, 9, 0.4);
+    let brute = run(&mesh, &exact_passes(0.0));
+    assert!(brute.failures.is_empty(), "{:#?}", brute.failures);
+    assert!(
+        brute.contractions > 100,
+        "{} contractions",
+        brute.contractions
+    );
+}
+
+#[test]
+fn the_sum_mode_double_counts_in_passes_too() {
+    let mesh = grid(6, 6, 0.4);
+    let brute = run(&mesh, &exact_passes(0.5).with_quadrics(QuadricMode::Sum));
+    assert!(!brute.failures.is_empty());
+}
+
 #[test]
 fn two_sheets_merging_through_virtual_pairs_match_brute_force() {
     // Two bumpy sheets 0.05 apart, one above the other: virtual pairs join them.
@@ -293,8 +320,31 @@ fn options() -> impl Strategy<Value = SimplifyOptions> {
         })
 }
 
+/// [`options`], but in the pass-based order (no virtual pairs, no topology
+/// preservation: it refuses both), with its own placement.
+fn passes_options() -> impl Strategy<Value = SimplifyOptions> {
+    (options(), any::<bool>()).prop_map(|(o, orientation)| {
+        o.with_order(ContractionOrder::Passes)
+            .with_pair_threshold(Length::DiagonalFraction(0.0))
+            .with_preserve_topology(false)
+            .with_placement(SimplifyOptions::FAST.placement)
+            .with_orientation_check(orientation)
+    })
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(256))]
+
+    /// The same in the pass-based order: collapsed triangles and border planes kept as
+    /// segments, followed through later contractions.
+    #[test]
+    fn every_contraction_in_passes_matches_the_brute_force_union(
+        mesh in prop_oneof![soup(30), bumpy_parts()], o in passes_options()
+    ) {
+        let brute = run(&mesh, &o);
+        prop_assert!(brute.failures.is_empty(), "{:#?}", brute.failures);
+        prop_assert!(brute.worst <= TOLERANCE);
+    }
 
     /// Messy soups (fins, merged duplicate faces and edges, wire edges) and stacked
     /// bumpy sheets (borders, virtual pairs): every contraction matches brute force.

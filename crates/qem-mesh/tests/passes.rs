@@ -272,10 +272,6 @@ fn options_the_passes_lack_are_refused_by_name() {
     let sphere = uv_sphere([0.0; 3], 1.0, 6, 8);
     let cases = [
         (
-            fast(Target::Ratio(0.5)).with_quadrics(QuadricMode::Exact),
-            "quadrics = Exact",
-        ),
-        (
             fast(Target::Ratio(0.5)).with_preserve_topology(true),
             "preserve_topology = true",
         ),
@@ -287,10 +283,12 @@ fn options_the_passes_lack_are_refused_by_name() {
             fast(Target::Ratio(0.5)).with_pair_threshold(Length::Absolute(0.1)),
             "pair_threshold above zero (virtual pairs)",
         ),
-        // The defaults ask for exact quadrics first.
+        // The defaults with a pair threshold (virtual pairs).
         (
-            SimplifyOptions::DEFAULT.with_order(ContractionOrder::Passes),
-            "quadrics = Exact",
+            SimplifyOptions::DEFAULT
+                .with_order(ContractionOrder::Passes)
+                .with_pair_threshold(Length::DiagonalFraction(0.01)),
+            "pair_threshold above zero (virtual pairs)",
         ),
     ];
     for (options, name) in cases {

@@ -11,8 +11,8 @@ use passes_common::{bits, border_loops, zero_area_faces_in_input_frame};
 use proptest::prelude::*;
 use qem_mesh::clean::{clean, CleanOptions, Cleaned};
 use qem_mesh::simplify::{
-    simplify, simplify_observed, BoundaryMode, Contraction, Observer, PlacementMode, SimplifyError,
-    SimplifyOptions, StopReason, Target, Weighting, DEFAULT_MAX_NORMAL_ANGLE,
+    simplify, simplify_observed, BoundaryMode, Contraction, Observer, PlacementMode, QuadricMode,
+    SimplifyError, SimplifyOptions, StopReason, Target, Weighting, DEFAULT_MAX_NORMAL_ANGLE,
 };
 use qem_mesh::IndexedMesh;
 use std::collections::BTreeSet;
@@ -73,7 +73,8 @@ fn bumpy_grid(keep_all: bool) -> impl Strategy<Value = IndexedMesh> {
 
 /// FAST at a random ratio, with the other options the pass-based order implements
 /// varied: border handling, placement, weighting, normal-angle limit (the default
-/// most often), sliver limit, the orientation check, and random locked vertices (some
+/// most often), sliver limit, the orientation check, exact quadrics, and random locked
+/// vertices (some
 /// out of range of the smaller inputs, which must be the documented error).
 fn fast_options() -> impl Strategy<Value = SimplifyOptions> {
     (
@@ -101,9 +102,10 @@ fn fast_options() -> impl Strategy<Value = SimplifyOptions> {
         prop_oneof![Just(0.0), 0.0..0.5f64],
         prop::collection::vec(0..200u32, 0..4),
         any::<bool>(),
+        any::<bool>(),
     )
         .prop_map(
-            |(r, boundary, placement, weighting, angle, sliver, locked, orientation)| {
+            |(r, boundary, placement, weighting, angle, sliver, locked, orientation, exact)| {
                 SimplifyOptions::FAST
                     .with_target(Target::Ratio(r))
                     .with_boundary(boundary)
@@ -113,6 +115,11 @@ fn fast_options() -> impl Strategy<Value = SimplifyOptions> {
                     .with_min_triangle_quality(sliver)
                     .with_locked_vertices(locked)
                     .with_orientation_check(orientation)
+                    .with_quadrics(if exact {
+                        QuadricMode::Exact
+                    } else {
+                        QuadricMode::Sum
+                    })
             },
         )
 }

@@ -11,7 +11,7 @@ mod common;
 mod passes_common;
 
 use passes_common::bits;
-use qem_mesh::simplify::{simplify, SimplifyOptions, StopReason, Target};
+use qem_mesh::simplify::{simplify, ContractionOrder, SimplifyOptions, StopReason, Target};
 use qem_mesh::IndexedMesh;
 use rayon::ThreadPoolBuilder;
 
@@ -62,14 +62,14 @@ fn fast_simplification_is_the_same_on_1_2_and_3_threads() {
     same_on_1_2_and_3_threads(&SimplifyOptions::FAST.with_target(Target::Ratio(0.05)));
 }
 
-/// With the orientation check, whose index is built on the other core while the
-/// quadrics are summed.
+/// The defaults in the pass-based order: exact quadrics, and the orientation check,
+/// whose index is built on the other core while the quadrics are summed.
 #[test]
-fn fast_simplification_with_the_orientation_check_is_the_same_on_1_2_and_3_threads() {
+fn defaults_in_passes_are_the_same_on_1_2_and_3_threads() {
     same_on_1_2_and_3_threads(
-        &SimplifyOptions::FAST
-            .with_target(Target::Ratio(0.05))
-            .with_orientation_check(true),
+        &SimplifyOptions::DEFAULT
+            .with_order(ContractionOrder::Passes)
+            .with_target(Target::Ratio(0.05)),
     );
 }
 

@@ -15,7 +15,9 @@
 //! `checks` (which contractions are allowed), `exact` (the inclusion–exclusion
 //! bookkeeping of [`QuadricMode::Exact`]), `passes` (the pass-based order,
 //! [`ContractionOrder::Passes`], on flat arrays instead of the store: the same checks
-//! but no heap; [`SimplifyOptions::FAST`]).
+//! but no heap; [`SimplifyOptions::FAST`]), `pass_exact` (exact quadrics in that
+//! order), `orientation` (the orientation check's index, both orders), `waivers`
+//! (pairs the orientation check refused, in the pass-based order).
 
 mod checks;
 mod engine;
@@ -23,6 +25,7 @@ mod exact;
 mod observer;
 mod options;
 mod orientation;
+mod pass_exact;
 mod passes;
 mod report;
 mod waivers;
@@ -294,9 +297,7 @@ fn set_up_greedy(
 /// [`SimplifyError::NotInPasses`] for the first option set that the pass-based order
 /// does not implement.
 fn refuse_what_passes_lack(options: &SimplifyOptions, frame: &Frame) -> Result<(), SimplifyError> {
-    let lacking = if options.quadrics == QuadricMode::Exact {
-        Some("quadrics = Exact")
-    } else if options.preserve_topology {
+    let lacking = if options.preserve_topology {
         Some("preserve_topology = true")
     } else if options.pair_threshold.normalized(frame) > 0.0 {
         Some("pair_threshold above zero (virtual pairs)")

@@ -153,12 +153,13 @@ pub enum ContractionOrder {
     /// batch of the cheapest, no two sharing a vertex, each checked like the greedy
     /// loop's (fold-over, merged faces, border loops, locks). Several times faster, at
     /// a small loss of quality: an edge whose cost fell during a pass waits for the
-    /// next one. Edges only, with summed quadrics and without topology preservation:
-    /// [`simplify`](super::simplify) refuses [`QuadricMode::Exact`],
-    /// `preserve_topology` and a `pair_threshold` above zero with
-    /// [`SimplifyError::NotInPasses`](super::SimplifyError::NotInPasses). The
-    /// orientation check is available (a refused pair is ranked at the same penalty
-    /// in later passes until one of its ends moves, and then tried without the check).
+    /// next one. Edges only, and without topology preservation:
+    /// [`simplify`](super::simplify) refuses `preserve_topology` and a
+    /// `pair_threshold` above zero with
+    /// [`SimplifyError::NotInPasses`](super::SimplifyError::NotInPasses). Exact
+    /// quadrics and the orientation check are available (a pair the check refuses is
+    /// ranked at the same penalty in later passes until one of its ends moves, and
+    /// then tried without the check).
     /// [`SimplifyOptions::FAST`] is the defaults with this order, summed quadrics, no
     /// orientation check and [`PlacementMode::SolveFirst`]. With a
     /// [`max_error`](SimplifyOptions::max_error) bound, a pair over the bound is never
@@ -332,10 +333,9 @@ impl SimplifyOptions {
         validate_each_contraction: false,
     };
 
-    /// [`DEFAULT`](Self::DEFAULT) in [`ContractionOrder::Passes`], with what that order
-    /// does not do turned off (summed quadrics, [`QuadricMode::Sum`]), the orientation
-    /// check off for speed, and the cheaper placement rule
-    /// [`PlacementMode::SolveFirst`].
+    /// [`DEFAULT`](Self::DEFAULT) in [`ContractionOrder::Passes`], with summed quadrics
+    /// ([`QuadricMode::Sum`]) and the orientation check off for speed, and the cheaper
+    /// placement rule [`PlacementMode::SolveFirst`].
     ///
     /// `FAST.with_orientation_check(true)` turns the check back on: on the 9 clean
     /// corpus scans at ratio 0.1, faces facing away from the nearest input face went

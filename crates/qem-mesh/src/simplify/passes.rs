@@ -20,12 +20,13 @@
 //! Why it is faster than [`ContractionOrder::Greedy`](super::ContractionOrder::Greedy): no heap and no store to keep
 //! consistent, each edge costed at most once per pass, and the contractions walk the
 //! arrays in order. What it gives up: the strict greedy order (an edge whose cost fell
-//! during a pass waits for the next one), exact quadrics, virtual pairs and topology
-//! preservation (each refused with
-//! [`SimplifyError::NotInPasses`](super::SimplifyError::NotInPasses)). The
-//! orientation check runs last among the checks, as in the greedy loop; a pair it
-//! refuses is ranked at the greedy loop's penalty in later passes and then tried
-//! without it ([`super::waivers`]).
+//! during a pass waits for the next one), virtual pairs and topology preservation
+//! (each refused with
+//! [`SimplifyError::NotInPasses`](super::SimplifyError::NotInPasses)). Exact quadrics
+//! keep their planes as [`super::pass_exact`] describes. The orientation check runs
+//! last among the checks, as in the greedy loop; a pair it refuses is ranked at the
+//! greedy loop's penalty in later passes and then tried without it
+//! ([`super::waivers`]).
 //!
 //! If a pass contracts nothing, its batch grows fourfold (without the pairs already
 //! refused) until every edge has been tried; a pass that still contracts nothing ends
@@ -42,8 +43,10 @@
 use super::checks::{moved_face_verdict, Rejection};
 use super::engine::{place_merged, Counters, Settings};
 use super::observer::{Contraction, Observer, Progress};
+use super::options::QuadricMode;
 use super::options::{BoundaryMode, SimplifyOptions};
 use super::orientation::InputSurface;
+use super::pass_exact::PassExact;
 use super::report::StopReason;
 use super::waivers::{penalised, Waivers};
 use crate::clean::cross_underflows;
@@ -161,6 +164,8 @@ pub(super) struct PassEngine {
     input_surface: Option<InputSurface>,
     /// Pairs refused by the orientation check, ranked at a penalty until tried again.
     waivers: Waivers,
+    /// The planes of exact quadrics; `None` with summed quadrics.
+    exact: Option<PassExact>,
 }
 
 impl PassEngine {
@@ -215,6 +220,8 @@ impl PassEngine {
             since_report: 0,
             input_surface: None,
             waivers: Waivers::new(n),
+            exact: (options.quadrics == QuadricMode::Exact)
+                .then(|| PassExact::new(cleaned.triangles.len(), n)),
             position,
         };
         let area_offset = engine.sum_face_planes(options);
@@ -262,7 +269,9 @@ impl PassEngine {
             areas / self.live.len() as f64
         };
         let area_offset = options.weighting.area_offset(mean_area);
-        let planes: Vec<(DVec3, Quadric)> = self
+        // Planes rather than quadrics collected (40 bytes a triangle instead of 80, at
+        // the setup's memory peak); each quadric is made as it is summed.
+        let planes: Vec<(DVec3, WeightedPlane)> = self
             .live
             .par_iter()
             .map(|&t| {
@@ -271,15 +280,19 @@ impl PassEngine {
                     Some(extra) => WeightedPlane::from_triangle_area_plus(pa, pb, pc, extra),
                     None => WeightedPlane::from_triangle_unweighted(pa, pb, pc),
                 };
-                ((pb - pa).cross(pc - pa), plane.quadric())
+                ((pb - pa).cross(pc - pa), plane)
             })
             .collect();
         // A triangle that is not live never has its normal read.
         self.original_normals = vec![DVec3::ZERO; self.triangles.len()];
-        for (&t, &(normal, q)) in self.live.iter().zip(&planes) {
+        for (&t, &(normal, plane)) in self.live.iter().zip(&planes) {
             self.original_normals[t as usize] = normal;
+            let q = plane.quadric();
             for c in self.triangles[t as usize] {
                 self.quadric[c as usize] += q;
+            }
+            if let Some(exact) = &mut self.exact {
+                exact.set_face_plane(t, plane);
             }
         }
         area_offset
@@ -388,6 +401,9 @@ impl PassEngine {
                 let q = Quadric::boundary_constraint(pa, pb, normal, plane_weight);
                 self.quadric[v as usize] += q;
                 self.quadric[x as usize] += q;
+                if let Some(exact) = &mut self.exact {
+                    exact.add_border_plane(v, x, q);
+                }
             }
         }
         self.best = count;
@@ -426,6 +442,9 @@ impl PassEngine {
         self.pass += 1;
         if self.pass > 1 {
             self.list_incident_triangles();
+        }
+        if let Some(exact) = &mut self.exact {
+            exact.start_pass();
         }
         self.list_edges();
         self.cost_edges();
@@ -660,13 +679,31 @@ impl PassEngine {
     /// The merged quadric of `a` and `b`, where the new vertex would go and its cost;
     /// a locked end stays put.
     fn place(&self, a: u32, b: u32) -> (Placement, Quadric) {
+        let mut q = self.quadric[a as usize] + self.quadric[b as usize];
+        if let Some(exact) = &self.exact {
+            q -= self.shared_planes(exact, a, b);
+        }
         let (a, b) = (a as usize, b as usize);
-        let q = self.quadric[a] + self.quadric[b];
         let ends = [
             (self.position[a], self.locked[a]),
             (self.position[b], self.locked[b]),
         ];
         (place_merged(&q, ends, self.settings.placement), q)
+    }
+
+    /// `Q_ab` of exact quadrics (see [`super::pass_exact`]) for `a` and `b`, both
+    /// unmoved in this pass: the face planes of the live triangles on both, then the
+    /// segments joining them.
+    fn shared_planes(&self, exact: &PassExact, a: u32, b: u32) -> Quadric {
+        let range = self.first[a as usize] as usize..self.first[a as usize + 1] as usize;
+        let mut sum = Quadric::ZERO;
+        for &t in &self.incident[range] {
+            let corners = self.triangles[t as usize];
+            if corners[0] != REMOVED && corners.contains(&b) {
+                sum += exact.face_quadric(t);
+            }
+        }
+        sum + exact.segments_between(a, b)
     }
 
     /// Checks and contracts the edge `a b` (both unmoved in this pass); `live` is the
@@ -754,6 +791,18 @@ impl PassEngine {
                 self.triangles[x.triangle as usize][0] = REMOVED;
                 removed += 1;
             }
+        }
+        if let Some(exact) = &mut self.exact {
+            // Each collapsed triangle's plane joins `a` and its third corner now.
+            let collapsed = around[0].iter().filter(|x| x.corners.contains(&b));
+            exact.contract(
+                a,
+                b,
+                collapsed.filter_map(|x| {
+                    let third = x.corners.into_iter().find(|&c| c != a && c != b)?;
+                    Some((x.triangle, third))
+                }),
+            );
         }
         // `b`'s other triangles are `a`'s now: renamed at once, so that every triangle
         // read later in the pass has its current corners.

@@ -164,7 +164,7 @@ pub enum SimplifyError {
     /// does not implement was asked for with it.
     NotInPasses {
         /// The option, as the field of [`SimplifyOptions`](super::SimplifyOptions)
-        /// and its value (for example `"quadrics = Exact"`).
+        /// and its value (for example `"preserve_topology = true"`).
         option: &'static str,
     },
     /// A bug: the store broke an invariant (only detected with
