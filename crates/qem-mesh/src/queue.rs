@@ -42,7 +42,8 @@ const ABSENT: u32 = u32::MAX;
 // so slots are not reused under it).
 use crate::store::slot_index as slot;
 
-/// Slot keys as dense 32-bit numbers in `as_ffi` order, and back.
+/// Slot keys as dense 32-bit numbers, and back. (In `as_ffi` order, which the queue's
+/// tie-break once used; the order no longer matters, only that the numbers are dense.)
 ///
 /// A store fresh from [`MeshStore::from_mesh`] has never removed anything, so all its
 /// keys share one version and the slot index alone is such a number (no table at
@@ -182,7 +183,7 @@ pub(crate) struct PairQueue {
     lines: Vec<Line>,
     /// Number of entries in the heap.
     len: usize,
-    /// Position and second vertex of every id.
+    /// Position and both vertices of every id.
     slots: Vec<Slot>,
     /// Vertex numbers, to keep a pair's vertices in 4 bytes each.
     vertices: Numbering<VertexKey>,
@@ -550,18 +551,22 @@ mod tests {
         let edges: Vec<EdgeKey> = store.edges().collect();
         let mut q = PairQueue::new(&store);
         q.next_stamp = u32::MAX - 3;
-        // Costs 1, 0, 1, 0, ...: the ties must pop in push order across the wrap.
-        for (k, &edge) in edges.iter().enumerate() {
+        // Before the wrap, costs 1, 1, 0: the 0 sifts to the root and moves the oldest
+        // 1 below the newer one, so stamps given in heap order would pop the two ties
+        // the wrong way round. Then more ties of both costs across the wrap.
+        let costs = [1.0, 1.0, 0.0, 1.0, 0.0, 1.0, 0.0, 1.0];
+        assert!(edges.len() >= costs.len());
+        for (&edge, &cost) in edges.iter().zip(&costs) {
             let [a, b] = store.edge_vertices(edge);
-            q.push((k % 2) as f64, a, b, Some(edge));
+            q.push(cost, a, b, Some(edge));
         }
         assert!(q.next_stamp < 100, "the stamps were renumbered");
         let popped: Vec<EdgeKey> = std::iter::from_fn(|| q.pop())
             .filter_map(|c| c.edge)
             .collect();
-        let expected: Vec<EdgeKey> = (0..2)
-            .flat_map(|parity| edges.iter().skip(parity).step_by(2).copied())
-            .collect();
+        let mut expected: Vec<(f64, usize)> = costs.iter().copied().zip(0..).collect();
+        expected.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+        let expected: Vec<EdgeKey> = expected.iter().map(|&(_, k)| edges[k]).collect();
         assert_eq!(popped, expected);
     }
 

@@ -494,8 +494,8 @@ impl Engine {
     /// edge, read straight from the store (no list of every edge key first: 48 MB on a
     /// 4M-triangle mesh). No pair is waived yet, so there is nothing for `unwaive` to
     /// do. The placements of a chunk of edges are solved on both cores, then queued in
-    /// edge order (the queue's pop order depends only on the keys, and the order of
-    /// pushes is the same as before anyway).
+    /// edge order: the order of pushes gives equal costs their order (first in, first
+    /// out), so it must not depend on the threads.
     fn queue_every_edge(&mut self) {
         let Engine {
             store,

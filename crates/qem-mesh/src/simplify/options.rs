@@ -158,8 +158,8 @@ pub enum ContractionOrder {
     /// `pair_threshold` above zero with
     /// [`SimplifyError::NotInPasses`](super::SimplifyError::NotInPasses). Exact
     /// quadrics and the orientation check are available (a pair the check refuses is
-    /// ranked at the same penalty in later passes until one of its ends moves, and
-    /// then tried without the check).
+    /// ranked at the same penalty in later passes and tried without the check next
+    /// time, unless one of its ends moves first).
     /// [`SimplifyOptions::FAST`] is the defaults with this order, summed quadrics, no
     /// orientation check and [`PlacementMode::SolveFirst`]. With a
     /// [`max_error`](SimplifyOptions::max_error) bound, a pair over the bound is never
@@ -238,8 +238,9 @@ pub struct SimplifyOptions {
     /// moving it 1e-6 of the normalised diagonal), and contracted without the check when
     /// it comes up again, unless it was re-costed meanwhile: at extreme ratios refusing
     /// for good would force far costlier contractions elsewhere. (In
-    /// [`ContractionOrder::Passes`], ranked at that cost in each later pass until
-    /// tried again or one of its ends moves.) Counted in
+    /// [`ContractionOrder::Passes`]: ranked at that cost in the later passes and
+    /// contracted without the check when next attempted, unless one of its ends moves
+    /// first, which has it costed and checked afresh.) Counted in
     /// [`SimplifyReport::rejected_orientation`](super::SimplifyReport::rejected_orientation).
     /// Default: `true`.
     pub orientation_check: bool,
@@ -340,7 +341,9 @@ impl SimplifyOptions {
     /// `FAST.with_orientation_check(true)` turns the check back on: on the 9 clean
     /// corpus scans at ratio 0.1, faces facing away from the nearest input face went
     /// from 0.01–0.35% on 4 scans to 0.04% on one, and the simplification took about
-    /// 1.75 times as long (BENCHMARKS.md, "The orientation check in passes").
+    /// 1.9 times as long (BENCHMARKS.md, "The orientation check in passes"); with
+    /// [`QuadricMode::Exact`] as well, every default quality option is on
+    /// ("Every default quality option in passes").
     ///
     /// ```
     /// use qem_mesh::simplify::{simplify, SimplifyOptions, Target};

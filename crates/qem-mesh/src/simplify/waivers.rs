@@ -1,13 +1,16 @@
 //! The orientation waivers of the pass-based order: pairs refused by the orientation
-//! check, costed at a penalty until one of their ends moves, and tried once more
-//! without the check.
+//! check, ranked at a penalty in later passes and then tried without the check.
 //!
 //! The greedy loop queues such a pair again at [`ORIENTATION_PENALTY`] times its cost
 //! and waives the check when it pops (see `Engine::waive`); the pass-based order has no
 //! queue, so it keeps the same facts here: which pairs are waived, so that each pass
 //! costs them at the penalty and their next attempt skips the check. A waiver ends when
-//! the pair is tried again or when either end moves (the greedy loop re-costs every pair
-//! of a moved vertex, which ends its waivers the same way).
+//! either end moves (the greedy loop re-costs every pair of a moved vertex, which ends
+//! its waivers the same way; the pair is then costed and checked afresh), or when an
+//! attempt of the pair gets past the other checks and the error bound, so reaches the
+//! point where the check would run. One difference from the greedy loop, which ends
+//! the waiver at the pop, before the other checks: here a waived pair that another
+//! check refuses keeps its waiver and its penalty.
 //!
 //! Why a flag per vertex beside the map: every edge of every pass asks whether it is
 //! waived, and once a pair has been refused the map is never empty again; the flags,
