@@ -9,7 +9,7 @@
 mod common;
 mod passes_common;
 
-use common::{assert_valid, concat, grid, torus, uv_sphere};
+use common::{assert_valid, concat, grid, jagged_sheet, torus, uv_sphere};
 use passes_common::{
     bits, border_and_nonmanifold_edges, border_loops, border_vertices, components, noisy_sphere,
     position_bits,
@@ -227,17 +227,6 @@ fn locked_boundary_keeps_every_border_vertex() {
         .collect();
     assert_eq!(border_out, border_in);
     assert_eq!(border_loops(&out.mesh), 1);
-}
-
-/// A 30 x 30 sheet whose heights are deterministic noise of ±0.3 (units of the grid
-/// step): crumpled, so contractions often swing a face over its neighbours (the sheet
-/// of the greedy order's `quality_scenarios.rs`).
-fn jagged_sheet() -> IndexedMesh {
-    let mut sheet = grid(30, 30, 0.0);
-    for (i, p) in sheet.positions.iter_mut().enumerate() {
-        p[2] = (((i * 7919) % 101) as f64 / 101.0 - 0.5) * 0.6;
-    }
-    sheet
 }
 
 // The orientation check alone (the fold-over check's angle limit off) keeps every face

@@ -3,7 +3,9 @@
 
 mod common;
 
-use common::{area, assert_valid, concat, grid, holed_grid, qualities, topology, uv_sphere};
+use common::{
+    area, assert_valid, concat, grid, holed_grid, jagged_sheet, qualities, topology, uv_sphere,
+};
 use qem_mesh::simplify::{
     simplify, BoundaryMode, Length, SimplifyError, SimplifyOptions, StopReason, Target,
     VirtualPairs,
@@ -12,16 +14,6 @@ use qem_mesh::IndexedMesh;
 
 fn at(ratio: f64) -> SimplifyOptions {
     SimplifyOptions::DEFAULT.with_target(Target::Ratio(ratio))
-}
-
-/// A 30 x 30 sheet whose heights are deterministic noise of ±0.3 (units of the grid
-/// step): crumpled, so contractions often swing a face over its neighbours.
-fn jagged_sheet() -> IndexedMesh {
-    let mut sheet = grid(30, 30, 0.0);
-    for (i, p) in sheet.positions.iter_mut().enumerate() {
-        p[2] = (((i * 7919) % 101) as f64 / 101.0 - 0.5) * 0.6;
-    }
-    sheet
 }
 
 #[test]

@@ -239,6 +239,16 @@ pub fn qualities(mesh: &IndexedMesh) -> Vec<f64> {
         .collect()
 }
 
+/// A 30 x 30 sheet whose heights are deterministic noise of ±0.3 (units of the grid
+/// step): crumpled, so contractions often swing a face over its neighbours.
+pub fn jagged_sheet() -> IndexedMesh {
+    let mut sheet = grid(30, 30, 0.0);
+    for (i, p) in sheet.positions.iter_mut().enumerate() {
+        p[2] = (((i * 7919) % 101) as f64 / 101.0 - 0.5) * 0.6;
+    }
+    sheet
+}
+
 /// A bumpy 16 x 16 grid with two 2 x 2 holes cut out: one part, three border loops.
 pub fn holed_grid() -> IndexedMesh {
     let g = grid(16, 16, 0.8);
