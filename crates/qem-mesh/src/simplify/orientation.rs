@@ -147,17 +147,30 @@ impl InputSurface {
     ) -> bool {
         let normal = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
         let centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
-        let hint = self.hint(face).or(*neighbour_hint);
+        let previous = *neighbour_hint;
+        let hint = self.hint(face).or(previous);
         *neighbour_hint = hint;
-        let known2 = hint.and_then(|h| self.bvh.distance_squared_to(centroid.to_array(), h));
-        if let Some(u2) = known2 {
-            let radius = (u2.sqrt() * NEAR_FACTOR + NEAR_MARGIN) * QUICK_RADIUS_FACTOR;
-            if radius.is_finite()
-                && !self
-                    .bvh
-                    .any_facing_away(centroid.to_array(), radius, normal.to_array())
-            {
-                return true;
+        let mut known2 = hint.and_then(|h| self.bvh.distance_squared_to(centroid.to_array(), h));
+        if self.quick_test(centroid, normal, known2) {
+            return true;
+        }
+        // Before the full test, the quick test once more with the triangle the face
+        // checked before this one settled on, when it is nearer than this face's own
+        // hint. Why: a contraction can move a face far from the input triangle it
+        // remembers (a fan's centre merging into its rim moves every fan face across
+        // the cap), so its own hint's ball reaches faces at right angles and the quick
+        // test fails; the neighbour's nearest triangle, found a moment ago next to
+        // the same moved vertex, is usually close. Either ball gives the same answer
+        // (see above); only the work differs.
+        if let Some(p) = previous.filter(|&p| Some(p) != hint) {
+            let p2 = self.bvh.distance_squared_to(centroid.to_array(), p);
+            if p2.is_some_and(|p2| known2.is_none_or(|u2| p2 < u2)) {
+                known2 = p2;
+                if self.quick_test(centroid, normal, known2) {
+                    self.set_hint(face, p);
+                    *neighbour_hint = Some(p);
+                    return true;
+                }
             }
         }
 
@@ -170,10 +183,7 @@ impl InputSurface {
             &mut self.near,
         );
         if let Some(t) = nearest {
-            if self.hints.len() <= face {
-                self.hints.resize(face + 1, NO_HINT);
-            }
-            self.hints[face] = t;
+            self.set_hint(face, t);
             *neighbour_hint = Some(t);
         }
         // A zero-area input triangle (cleaning drops exact ones) has no say.
@@ -184,5 +194,28 @@ impl InputSurface {
             let n = (b - a).cross(c - a);
             n.dot(normal) > 0.0 || n == DVec3::ZERO
         })
+    }
+
+    /// The quick test of [`agrees`](Self::agrees): with `known2` a squared distance
+    /// from `centroid` to some input triangle, whether no triangle within the ball it
+    /// bounds faces away from `normal` (false also when there is no such bound).
+    #[inline]
+    fn quick_test(&self, centroid: DVec3, normal: DVec3, known2: Option<f64>) -> bool {
+        let Some(u2) = known2 else {
+            return false;
+        };
+        let radius = (u2.sqrt() * NEAR_FACTOR + NEAR_MARGIN) * QUICK_RADIUS_FACTOR;
+        radius.is_finite()
+            && !self
+                .bvh
+                .any_facing_away(centroid.to_array(), radius, normal.to_array())
+    }
+
+    /// Makes `t` the hint of `face`.
+    fn set_hint(&mut self, face: usize, t: u32) {
+        if self.hints.len() <= face {
+            self.hints.resize(face + 1, NO_HINT);
+        }
+        self.hints[face] = t;
     }
 }
