@@ -658,11 +658,17 @@ impl PassEngine {
         // The unpenalised costs are the ones a later pass may reuse.
         self.last_listed.clone_from(&self.candidates);
         std::mem::swap(&mut self.last_listed_first, &mut self.listed_first);
-        for c in &mut self.candidates {
-            if self.waivers.contains(c.a, c.b) {
-                let q = self.quadric[c.a as usize] + self.quadric[c.b as usize];
-                c.cost = penalised(c.cost, &q);
-            }
+        // Waived pairs are ranked at the greedy loop's penalty on their merged quadric.
+        // (Few: a pass lists them first, then reads their quadrics.)
+        let waived: Vec<usize> = (0..self.candidates.len())
+            .filter(|&i| {
+                let c = &self.candidates[i];
+                self.waivers.contains(c.a, c.b)
+            })
+            .collect();
+        for i in waived {
+            let Candidate { a, b, cost } = self.candidates[i];
+            self.candidates[i].cost = penalised(cost, &self.merged_quadric(a, b));
         }
     }
 
@@ -684,16 +690,22 @@ impl PassEngine {
     /// The merged quadric of `a` and `b`, where the new vertex would go and its cost;
     /// a locked end stays put.
     fn place(&self, a: u32, b: u32) -> (Placement, Quadric) {
-        let mut q = self.quadric[a as usize] + self.quadric[b as usize];
-        if let Some(exact) = &self.exact {
-            q -= self.shared_planes(exact, a, b);
-        }
+        let q = self.merged_quadric(a, b);
         let (a, b) = (a as usize, b as usize);
         let ends = [
             (self.position[a], self.locked[a]),
             (self.position[b], self.locked[b]),
         ];
         (place_merged(&q, ends, self.settings.placement), q)
+    }
+
+    /// The quadric of `a` and `b` merged: `Q_a + Q_b`, less `Q_ab` with exact quadrics.
+    fn merged_quadric(&self, a: u32, b: u32) -> Quadric {
+        let mut q = self.quadric[a as usize] + self.quadric[b as usize];
+        if let Some(exact) = &self.exact {
+            q -= self.shared_planes(exact, a, b);
+        }
+        q
     }
 
     /// `Q_ab` of exact quadrics (see [`super::pass_exact`]) for `a` and `b`, both
