@@ -53,8 +53,8 @@ pub(super) struct InputSurface {
     /// Reused query result.
     near: Vec<u32>,
     /// Per face, an input triangle near it: at first the face's own input triangle,
-    /// then the nearest one at the face's last full test; [`NO_HINT`] when there is
-    /// none yet. Its distance to the face's new centroid bounds the nearest distance
+    /// then the nearest one at the face's last full test, or the previous face's
+    /// triangle when a quick test with it passed; [`NO_HINT`] when there is none yet. Its distance to the face's new centroid bounds the nearest distance
     /// from above, which is what the quick test needs (and lets the full test prune
     /// from its first node). Any triangle would give the same answers; a nearer one
     /// gives them sooner.

@@ -145,13 +145,22 @@ impl PassExact {
     }
 
     /// The sum of the segments joining `a` and `b`, both unmoved in this pass.
+    ///
+    /// Walks the shorter of the two ends' lists (a vertex that absorbed many others
+    /// has a long one); both list the segments in increasing order, so the sum is the
+    /// same to the bit either way.
     #[inline]
     pub fn segments_between(&self, a: u32, b: u32) -> Quadric {
-        let range = self.first[a as usize] as usize..self.first[a as usize + 1] as usize;
+        let range = |v: u32| self.first[v as usize] as usize..self.first[v as usize + 1] as usize;
+        let (walk, other) = if range(a).len() <= range(b).len() {
+            (a, b)
+        } else {
+            (b, a)
+        };
         let mut sum = Quadric::ZERO;
-        for &i in &self.by_end[range] {
+        for &i in &self.by_end[range(walk)] {
             let s = self.segments[i as usize];
-            if s.ends.contains(&b) {
+            if s.ends.contains(&other) {
                 sum += self.plane(s.source);
             }
         }

@@ -271,7 +271,8 @@ impl PassEngine {
         };
         let area_offset = options.weighting.area_offset(mean_area);
         // Planes rather than quadrics collected (40 bytes a triangle instead of 80, at
-        // the setup's memory peak); each quadric is made as it is summed.
+        // the setup's memory peak); each quadric is made as it is summed. (With exact
+        // quadrics the planes are also kept for the run, 40 bytes a triangle more.)
         let planes: Vec<(DVec3, WeightedPlane)> = self
             .live
             .par_iter()
@@ -711,12 +712,23 @@ impl PassEngine {
     /// `Q_ab` of exact quadrics (see [`super::pass_exact`]) for `a` and `b`, both
     /// unmoved in this pass: the face planes of the live triangles on both, then the
     /// segments joining them.
+    ///
+    /// Walks the shorter of the two ends' lists: at a fan's centre, walking its own
+    /// list for each of its edges was quadratic (found in review: a cylinder with
+    /// 80,000-segment fan caps, 16.7 s against 0.5 s with summed quadrics). Either list
+    /// holds the triangles on both ends in increasing order, so the sum is the same to
+    /// the bit whichever is walked.
     fn shared_planes(&self, exact: &PassExact, a: u32, b: u32) -> Quadric {
-        let range = self.first[a as usize] as usize..self.first[a as usize + 1] as usize;
+        let range = |v: u32| self.first[v as usize] as usize..self.first[v as usize + 1] as usize;
+        let (walk, other) = if range(a).len() <= range(b).len() {
+            (a, b)
+        } else {
+            (b, a)
+        };
         let mut sum = Quadric::ZERO;
-        for &t in &self.incident[range] {
+        for &t in &self.incident[range(walk)] {
             let corners = self.triangles[t as usize];
-            if corners[0] != REMOVED && corners.contains(&b) {
+            if corners[0] != REMOVED && corners.contains(&other) {
                 sum += exact.face_quadric(t);
             }
         }
