@@ -151,14 +151,9 @@ impl PassExact {
     /// same to the bit either way.
     #[inline]
     pub fn segments_between(&self, a: u32, b: u32) -> Quadric {
-        let range = |v: u32| self.first[v as usize] as usize..self.first[v as usize + 1] as usize;
-        let (walk, other) = if range(a).len() <= range(b).len() {
-            (a, b)
-        } else {
-            (b, a)
-        };
+        let ((_, other), range) = shorter_list(&self.first, a, b);
         let mut sum = Quadric::ZERO;
-        for &i in &self.by_end[range(walk)] {
+        for &i in &self.by_end[range] {
             let s = self.segments[i as usize];
             if s.ends.contains(&other) {
                 sum += self.plane(s.source);
@@ -174,6 +169,18 @@ impl PassExact {
             Some(border) => self.border_planes[border],
             None => self.face_quadric(source),
         }
+    }
+}
+
+/// Of two vertices with lists `by_vertex[first[v]..first[v + 1]]`, the one with the
+/// shorter list (the first on a tie) and the other, and that list's range: the side
+/// to walk when looking for what both share.
+pub(super) fn shorter_list(first: &[u32], a: u32, b: u32) -> ((u32, u32), std::ops::Range<usize>) {
+    let range = |v: u32| first[v as usize] as usize..first[v as usize + 1] as usize;
+    if range(a).len() <= range(b).len() {
+        ((a, b), range(a))
+    } else {
+        ((b, a), range(b))
     }
 }
 

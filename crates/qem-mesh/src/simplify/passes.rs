@@ -46,7 +46,7 @@ use super::observer::{Contraction, Observer, Progress};
 use super::options::QuadricMode;
 use super::options::{BoundaryMode, SimplifyOptions};
 use super::orientation::InputSurface;
-use super::pass_exact::PassExact;
+use super::pass_exact::{shorter_list, PassExact};
 use super::report::StopReason;
 use super::waivers::{penalised, Waivers};
 use crate::clean::cross_underflows;
@@ -719,14 +719,9 @@ impl PassEngine {
     /// holds the triangles on both ends in increasing order, so the sum is the same to
     /// the bit whichever is walked.
     fn shared_planes(&self, exact: &PassExact, a: u32, b: u32) -> Quadric {
-        let range = |v: u32| self.first[v as usize] as usize..self.first[v as usize + 1] as usize;
-        let (walk, other) = if range(a).len() <= range(b).len() {
-            (a, b)
-        } else {
-            (b, a)
-        };
+        let ((_, other), range) = shorter_list(&self.first, a, b);
         let mut sum = Quadric::ZERO;
-        for &t in &self.incident[range(walk)] {
+        for &t in &self.incident[range] {
             let corners = self.triangles[t as usize];
             if corners[0] != REMOVED && corners.contains(&other) {
                 sum += exact.face_quadric(t);
