@@ -42,6 +42,7 @@
 
 mod bvh;
 mod facing;
+mod pieces;
 
 use crate::input::{IndexedMesh, InputError};
 pub use bvh::TriangleBvh;

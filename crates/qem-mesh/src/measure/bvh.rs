@@ -8,12 +8,18 @@
 //! instructions, and a node costs about 54 bytes per child instead of 56 for a binary
 //! node plus 48 for its normal box.
 //!
+//! Long thin triangles are indexed in pieces (see [`pieces`](super::pieces)): a
+//! leaf entry is then a piece, which names its triangle, and a triangle may be met
+//! more than once in a walk. Meshes without such triangles have no pieces, and their
+//! tree is the one a leaf entry per triangle gives.
+//!
 //! Why `f32` boxes change no answer: every box is rounded outward, so the distance to
 //! it is never more than the distance to the exact box, and a subtree is skipped only
 //! when it is farther than the pruning bound; the answers themselves come from the
 //! exact `f64` triangle distances at the leaves.
 
 use super::facing::MIN_PRUNING_LENGTH;
+use super::pieces;
 use super::{cross, length, sub, triangle_distance2, P3};
 use crate::input::IndexedMesh;
 use rayon::prelude::*;
@@ -48,6 +54,14 @@ impl Aabb {
         for (k, &x) in p.iter().enumerate() {
             self.lo[k] = self.lo[k].min(x);
             self.hi[k] = self.hi[k].max(x);
+        }
+    }
+
+    /// Grows the box to hold `other` (nothing, when `other` is empty).
+    fn add(&mut self, other: &Aabb) {
+        for k in 0..3 {
+            self.lo[k] = self.lo[k].min(other.lo[k]);
+            self.hi[k] = self.hi[k].max(other.hi[k]);
         }
     }
 }
@@ -211,8 +225,12 @@ impl<T: Copy + Default> NodeStack<T> {
 pub struct TriangleBvh {
     /// The wide tree; node 0 is the root. Empty when there are no triangles.
     pub(super) nodes: Vec<WideNode>,
-    /// Triangle corners in leaf order: the leaf's triangles are contiguous.
+    /// Triangle corners, numbered in the order the leaves first meet them: without
+    /// pieces, a leaf's triangles are contiguous.
     pub(super) corners: Vec<[P3; 3]>,
+    /// The triangle of each leaf entry, when some triangle is indexed in pieces (see
+    /// the module docs); `None` when every leaf entry is its own triangle, in order.
+    pub(super) pieces: Option<Vec<u32>>,
     /// Absolute part of the pruning margin (squared): rounding of coordinates at the
     /// scale of the whole tree.
     pub(super) slack2: f64,
@@ -249,7 +267,7 @@ impl TriangleBvh {
     /// triangle with a NaN corner is never found by the searches.
     pub fn from_corners(mut corners: Vec<[P3; 3]>) -> (TriangleBvh, Vec<u32>) {
         corners.truncate(u32::MAX as usize);
-        let (nodes, slots, root) = build(&mut corners);
+        let (nodes, slots, root, pieces) = build(&mut corners);
         let scale = (0..3)
             .map(|k| root.lo[k].abs().max(root.hi[k].abs()))
             .fold(0.0, f64::max);
@@ -262,17 +280,27 @@ impl TriangleBvh {
             TriangleBvh {
                 nodes,
                 corners,
+                pieces,
                 slack2: slack * slack,
             },
             slots,
         )
     }
 
+    /// The triangle of leaf entry `entry` (an index for [`corners`](Self::corners)).
+    #[inline(always)]
+    pub(super) fn triangle_of(&self, entry: usize) -> usize {
+        match &self.pieces {
+            None => entry,
+            Some(pieces) => pieces[entry] as usize,
+        }
+    }
+
     /// Visits node `w` of a nearest-first walk: tests the triangles of its leaf
     /// children, nearest child first, and pushes its inner children with their box
     /// distances, farthest first (so the nearest is popped next). `prune` gives the
-    /// current bound on squared distances and `leaf` takes each triangle index of a leaf
-    /// child within it.
+    /// current bound on squared distances and `leaf` takes the triangle (index) of each
+    /// entry of a leaf child within it (a triangle in pieces may come more than once).
     #[inline(always)]
     fn visit_nearest_first(
         &self,
@@ -305,8 +333,8 @@ impl TriangleBvh {
                 continue;
             }
             let start = node.child[i] as usize;
-            for t in start..start + count {
-                leaf(t);
+            for entry in start..start + count {
+                leaf(self.triangle_of(entry));
             }
         }
         for &(d2, i) in by_distance.iter().rev().filter(|x| x.1 < WIDTH) {
@@ -422,7 +450,12 @@ impl TriangleBvh {
             let mut candidates = candidates.borrow_mut();
             let at =
                 candidates.partition_point(|x| x.0.total_cmp(&d2).then(x.1.cmp(&entry.1)).is_lt());
-            if at < keep {
+            // A triangle met again through another of its pieces: the same distance,
+            // already there.
+            let again = candidates
+                .get(at)
+                .is_some_and(|x| x.1 == entry.1 && x.0.to_bits() == d2.to_bits());
+            if at < keep && !again {
                 candidates.insert(at, entry);
                 candidates.truncate(keep);
             }
@@ -470,44 +503,59 @@ impl TriangleBvh {
     }
 }
 
-/// The tree over `corners` (reordered in place into leaf order), node 0 the root,
-/// every node after its parent; where each triangle went (`slots[i]` is the new index
-/// of the triangle that was at `i`); and the box of all the corners.
+/// The tree over `corners` (renumbered in place, see [`TriangleBvh::corners`]), node 0
+/// the root, every node after its parent; where each triangle went (`slots[i]` is the
+/// new index of the triangle that was at `i`); the box of all the corners; and the
+/// triangle of each leaf entry when some triangle is indexed in pieces (see
+/// [`pieces`]).
 ///
-/// The splits are those of a binary tree: a range of more than [`LEAF_SIZE`] triangles
+/// The splits are those of a binary tree: a range of more than [`LEAF_SIZE`] entries
 /// is split at its median centroid along the longest axis of its centroids' box (ties
-/// broken by triangle index, so the tree is deterministic). A node stands for one such
+/// broken by entry number, so the tree is deterministic). A node stands for one such
 /// split and its two halves' splits: its children are the four quarter ranges (or a
 /// half, where the half is a leaf). Built straight into wide nodes, so the build never
 /// holds a binary node per range (56 bytes each, about 134 MB on the 4M sphere).
 ///
 /// Four steps, so that none reads corners out of order: [`partition`] puts every
-/// triangle in its leaf (on both cores), the corners move to leaf order, [`wide_nodes`]
+/// entry in its leaf (on both cores), the corners move to leaf order, [`wide_nodes`]
 /// lays out the nodes (which needs only the range sizes), and [`fill_boxes`] fills in
 /// the boxes bottom-up. Why: building top-down with each range's box computed as its
 /// split was made read every triangle's 72 bytes of corners at random, once per level;
 /// that was most of the index build, then the longer half of the simplifier's setup.
-fn build(corners: &mut [[P3; 3]]) -> (Vec<WideNode>, Vec<u32>, Aabb) {
+fn build(corners: &mut [[P3; 3]]) -> (Vec<WideNode>, Vec<u32>, Aabb, Option<Vec<u32>>) {
     let mut root_bounds = Aabb::EMPTY;
     for corner in corners.iter().flatten() {
         root_bounds.grow(*corner);
     }
+    let extent = sub(root_bounds.hi, root_bounds.lo);
+    let (nodes, slots, pieces) = match pieces::piece_counts(corners, length(extent)) {
+        None => {
+            let (nodes, slots) = build_whole(corners);
+            (nodes, slots, None)
+        }
+        Some(counts) => {
+            let (nodes, slots, pieces) = build_in_pieces(corners, &counts);
+            (nodes, slots, Some(pieces))
+        }
+    };
+    (nodes, slots, root_bounds, pieces)
+}
+
+/// A NaN coordinate (from infinite or NaN corners, which callers should not pass)
+/// becomes the one canonical NaN: the split's `total_cmp` orders NaNs by their bits,
+/// which arithmetic does not fix, and the tree must not depend on them.
+fn canonical(p: P3) -> P3 {
+    p.map(|x| if x.is_nan() { f64::NAN } else { x })
+}
+
+/// [`build`] with a leaf entry per triangle.
+fn build_whole(corners: &mut [[P3; 3]]) -> (Vec<WideNode>, Vec<u32>) {
     // The centroids, kept for the split only (24 bytes per triangle): recomputing them
     // inside the median selection's comparisons made the dragon's index build about
-    // 0.3 s slower. A NaN coordinate (from infinite or NaN corners, which callers
-    // should not pass) becomes the one canonical NaN: the split's `total_cmp` orders
-    // NaNs by their bits, which arithmetic does not fix, and the tree must not depend
-    // on them.
-    let canonical = |x: f64| if x.is_nan() { f64::NAN } else { x };
+    // 0.3 s slower.
     let centroids: Vec<P3> = corners
         .par_iter()
-        .map(|c| {
-            [
-                canonical((c[0][0] + c[1][0] + c[2][0]) / 3.0),
-                canonical((c[0][1] + c[1][1] + c[2][1]) / 3.0),
-                canonical((c[0][2] + c[1][2] + c[2][2]) / 3.0),
-            ]
-        })
+        .map(|c| canonical([0, 1, 2].map(|k| (c[0][k] + c[1][k] + c[2][k]) / 3.0)))
         .collect();
     let mut order: Vec<u32> = (0..corners.len() as u32).collect();
     partition(&mut order, &centroids);
@@ -517,9 +565,71 @@ fn build(corners: &mut [[P3; 3]]) -> (Vec<WideNode>, Vec<u32>, Aabb) {
         slots[t as usize] = slot as u32;
     }
     drop(order);
-    // Leaf order in place: each triangle swapped straight to its slot, cycle by
-    // cycle (`destination` follows the triangles as they move).
-    let mut destination = slots.clone();
+    move_to_slots(corners, &slots);
+    let mut nodes = wide_nodes(corners.len());
+    fill_boxes(&mut nodes, |entry| {
+        let c = &corners[entry];
+        (*c, pieces::piece_box(c, 0, 1))
+    });
+    (nodes, slots)
+}
+
+/// [`build`] with triangle `t` cut into `counts[t]` pieces: a leaf entry per piece.
+/// Triangles are numbered in the order the leaves first meet them.
+fn build_in_pieces(corners: &mut [[P3; 3]], counts: &[u8]) -> (Vec<WideNode>, Vec<u32>, Vec<u32>) {
+    // first[t]: the number of triangle t's first piece; pieces are numbered triangle
+    // by triangle (u32: the budget keeps their count within twice the triangles').
+    let mut first = Vec::with_capacity(counts.len() + 1);
+    let mut total = 0u32;
+    for &k in counts {
+        first.push(total);
+        total += u32::from(k);
+    }
+    first.push(total);
+    let triangle_and_piece = |entry: u32| {
+        let t = first.partition_point(|&f| f <= entry) - 1;
+        (t, (entry - first[t]) as usize, usize::from(counts[t]))
+    };
+    let centroids: Vec<P3> = (0..total)
+        .into_par_iter()
+        .map(|entry| {
+            let (t, j, k) = triangle_and_piece(entry);
+            let c = &corners[t];
+            canonical(if k == 1 {
+                [0, 1, 2].map(|i| (c[0][i] + c[1][i] + c[2][i]) / 3.0)
+            } else {
+                pieces::piece_centre(c, j, k)
+            })
+        })
+        .collect();
+    let mut order: Vec<u32> = (0..total).collect();
+    partition(&mut order, &centroids);
+    drop(centroids);
+    let mut slots = vec![u32::MAX; corners.len()];
+    let mut next = 0u32;
+    let mut leaf_triangles = Vec::with_capacity(order.len());
+    for &entry in &order {
+        let (t, _, _) = triangle_and_piece(entry);
+        if slots[t] == u32::MAX {
+            slots[t] = next;
+            next += 1;
+        }
+        leaf_triangles.push(slots[t]);
+    }
+    move_to_slots(corners, &slots);
+    let mut nodes = wide_nodes(order.len());
+    fill_boxes(&mut nodes, |entry| {
+        let (_, j, k) = triangle_and_piece(order[entry]);
+        let c = &corners[leaf_triangles[entry] as usize];
+        (*c, pieces::piece_box(c, j, k))
+    });
+    (nodes, slots, leaf_triangles)
+}
+
+/// Moves each triangle to its slot in place, cycle by cycle (`destination` follows the
+/// triangles as they move).
+fn move_to_slots(corners: &mut [[P3; 3]], slots: &[u32]) {
+    let mut destination = slots.to_vec();
     for i in 0..corners.len() {
         while destination[i] as usize != i {
             let d = destination[i] as usize;
@@ -527,10 +637,6 @@ fn build(corners: &mut [[P3; 3]]) -> (Vec<WideNode>, Vec<u32>, Aabb) {
             destination.swap(i, d);
         }
     }
-    drop(destination);
-    let mut nodes = wide_nodes(corners.len());
-    fill_boxes(&mut nodes, corners);
-    (nodes, slots, root_bounds)
 }
 
 /// Ranges at least this long are split on both cores (below it, handing work to rayon
@@ -675,7 +781,10 @@ fn wide_node_count(n: usize) -> usize {
 /// value). (`min` and `max` of 0.0 and −0.0 keep whichever came first, so the sign of
 /// a zero bound depends on the order of the corners; every reader compares or squares
 /// the bounds, where the two zeros are equal.)
-fn fill_boxes(nodes: &mut [WideNode], corners: &[[P3; 3]]) {
+///
+/// `entry(e)` gives leaf entry `e`'s triangle and its box (the triangle's, or its
+/// piece's).
+fn fill_boxes(nodes: &mut [WideNode], entry: impl Fn(usize) -> ([P3; 3], (P3, P3))) {
     for w in (0..nodes.len()).rev() {
         for i in 0..usize::from(nodes[w].lanes) {
             let mut position = Box32::EMPTY;
@@ -683,14 +792,11 @@ fn fill_boxes(nodes: &mut [WideNode], corners: &[[P3; 3]]) {
             let count = usize::from(nodes[w].leaf_count[i]);
             let first = nodes[w].child[i] as usize;
             if count > 0 {
-                let triangles = &corners[first..first + count];
                 let mut bounds = Aabb::EMPTY;
-                for corner in triangles.iter().flatten() {
-                    bounds.grow(*corner);
-                }
-                position = Box32::around(bounds.lo, bounds.hi);
-                for [a, b, c] in triangles {
-                    let normal = cross(sub(*b, *a), sub(*c, *a));
+                for e in first..first + count {
+                    let ([a, b, c], (lo, hi)) = entry(e);
+                    bounds.add(&Aabb { lo, hi });
+                    let normal = cross(sub(b, a), sub(c, a));
                     let length = length(normal);
                     if length >= MIN_PRUNING_LENGTH && length.is_finite() {
                         let unit = normal.map(|x| x / length);
@@ -699,6 +805,7 @@ fn fill_boxes(nodes: &mut [WideNode], corners: &[[P3; 3]]) {
                         normals.grow(&Box32::around([-1.0; 3], [1.0; 3]));
                     }
                 }
+                position = Box32::around(bounds.lo, bounds.hi);
             } else {
                 let child = &nodes[first];
                 for j in 0..usize::from(child.lanes) {
@@ -762,7 +869,7 @@ mod tests {
                     [[x, 0.0, 0.0], [x, 1.0, 0.0], [x, 0.0, 1.0]]
                 })
                 .collect();
-            let (nodes, _, _) = build(&mut corners);
+            let (nodes, _, _, _) = build(&mut corners);
             assert_eq!(nodes.len(), wide_node_count(n), "{n} triangles");
         }
     }
@@ -799,12 +906,10 @@ mod tests {
                     continue;
                 }
                 let start = node.child[i] as usize;
-                for (seen, corners) in seen[start..start + count]
-                    .iter_mut()
-                    .zip(&bvh.corners[start..start + count])
-                {
+                for (entry, seen) in seen.iter_mut().enumerate().skip(start).take(count) {
+                    assert_eq!(bvh.triangle_of(entry), entry);
                     *seen += 1;
-                    for corner in corners {
+                    for corner in &bvh.corners[entry] {
                         for (k, &x) in corner.iter().enumerate() {
                             assert!(f64::from(lane.lo[k]) <= x && x <= f64::from(lane.hi[k]));
                         }
@@ -813,8 +918,145 @@ mod tests {
             }
         }
         assert!(seen.iter().all(|&n| n == 1), "{seen:?}");
+        assert!(bvh.pieces.is_none());
         for (i, &slot) in slots.iter().enumerate() {
             assert_eq!(bvh.corners(slot), corners[i]);
+        }
+    }
+
+    /// A fan of long slivers across a grid of small triangles, and a cone of slivers
+    /// through it: the kind of mesh that is indexed in pieces.
+    fn fan_over_grid() -> Vec<[P3; 3]> {
+        let mut corners = Vec::new();
+        for i in 0..30 {
+            for j in 0..30 {
+                let (x, y) = (f64::from(i) * 0.1, f64::from(j) * 0.1);
+                corners.push([[x, y, 0.0], [x + 0.1, y, 0.0], [x, y + 0.1, 0.0]]);
+                corners.push([
+                    [x + 0.1, y, 0.0],
+                    [x + 0.1, y + 0.1, 0.0],
+                    [x, y + 0.1, 0.0],
+                ]);
+            }
+        }
+        for i in 0..200 {
+            let a = f64::from(i) * 0.007;
+            let b = a + 0.007;
+            corners.push([
+                [0.0, 0.0, 0.05],
+                [3.0 * a.cos(), 3.0 * a.sin(), 0.05],
+                [3.0 * b.cos(), 3.0 * b.sin(), 0.05],
+            ]);
+            corners.push([
+                [1.5, 1.5, 1.0],
+                [3.0 * b.cos(), 3.0 * b.sin(), -0.5],
+                [3.0 * a.cos(), 3.0 * a.sin(), -0.5],
+            ]);
+        }
+        corners
+    }
+
+    /// With pieces, every triangle is found through its pieces: each point of a
+    /// triangle lies in the box of a leaf child that holds one of its pieces, and the
+    /// numbering still maps every input triangle to its corners.
+    #[test]
+    fn pieces_cover_their_triangles() {
+        let corners = fan_over_grid();
+        let (bvh, slots) = TriangleBvh::from_corners(corners.clone());
+        let pieces = bvh.pieces.as_ref().expect("the slivers are cut");
+        assert!(pieces.len() > corners.len());
+        for (i, &slot) in slots.iter().enumerate() {
+            assert_eq!(bvh.corners(slot), corners[i]);
+        }
+        // Leaf children: their box and the triangles of their entries.
+        let mut leaves: Vec<(Box32, Vec<usize>)> = Vec::new();
+        for node in &bvh.nodes {
+            for i in 0..usize::from(node.lanes) {
+                let count = usize::from(node.leaf_count[i]);
+                if count > 0 {
+                    let start = node.child[i] as usize;
+                    let lane = Box32 {
+                        lo: [0, 1, 2].map(|k| node.lo[k][i]),
+                        hi: [0, 1, 2].map(|k| node.hi[k][i]),
+                    };
+                    leaves.push((
+                        lane,
+                        (start..start + count).map(|e| bvh.triangle_of(e)).collect(),
+                    ));
+                }
+            }
+        }
+        let entries: usize = leaves.iter().map(|l| l.1.len()).sum();
+        assert_eq!(entries, pieces.len());
+        for t in 0..bvh.triangle_count() {
+            let [a, b, c] = bvh.corners(t as u32);
+            for (u, v) in [
+                (0.0, 0.0),
+                (1.0, 0.0),
+                (0.0, 1.0),
+                (0.5, 0.5),
+                (0.3, 0.1),
+                (0.05, 0.9),
+            ] {
+                let p = [0, 1, 2].map(|k| a[k] + u * (b[k] - a[k]) + v * (c[k] - a[k]));
+                let held = leaves.iter().any(|(lane, triangles)| {
+                    triangles.contains(&t)
+                        && (0..3)
+                            .all(|k| f64::from(lane.lo[k]) <= p[k] && p[k] <= f64::from(lane.hi[k]))
+                });
+                assert!(held, "triangle {t}: {p:?} in no leaf of its pieces");
+            }
+        }
+    }
+
+    /// With pieces, the searches answer as brute force does: distances, the nearest
+    /// triangles (each once), and the facing-away search.
+    #[test]
+    fn searches_over_pieces_match_brute_force() {
+        let corners = fan_over_grid();
+        let (bvh, _) = TriangleBvh::from_corners(corners);
+        assert!(bvh.pieces.is_some());
+        let squared = |p: P3, t: u32| {
+            let [a, b, c] = bvh.corners(t);
+            triangle_distance2(p, a, b, c)
+        };
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut near = Vec::new();
+        for _ in 0..400 {
+            let p = [next() * 3.4 - 0.2, next() * 3.4 - 0.2, next() * 1.2 - 0.4];
+            let mut all: Vec<(f64, u32)> = (0..bvh.triangle_count() as u32)
+                .map(|t| (squared(p, t), t))
+                .collect();
+            all.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+            assert_eq!(bvh.distance(p), Some(all[0].0.sqrt()));
+            let nearest = bvh.nearest_triangles(p, 1.5, 1e-9, 8, &mut near);
+            assert_eq!(nearest, Some(all[0].1));
+            let limit = all[0].0.sqrt() * 1.5 + 1e-9;
+            let mut expected: Vec<u32> = all
+                .iter()
+                .filter(|x| x.0.sqrt() <= limit)
+                .take(8)
+                .map(|x| x.1)
+                .collect();
+            expected.sort_unstable();
+            assert_eq!(near, expected, "at {p:?}");
+            let normal = [next() - 0.5, next() - 0.5, next() - 0.5];
+            let radius = next() * 0.3;
+            let brute = (0..bvh.triangle_count() as u32).any(|t| {
+                let [a, b, c] = bvh.corners(t);
+                let n = cross(sub(b, a), sub(c, a));
+                let d = n[0] * normal[0] + n[1] * normal[1] + n[2] * normal[2];
+                d <= 0.0 && n != [0.0; 3] && squared(p, t) <= radius * radius
+            });
+            if brute {
+                assert!(bvh.any_facing_away(p, radius, normal), "at {p:?}");
+            }
         }
     }
 

@@ -75,7 +75,8 @@ impl TriangleBvh {
                     continue;
                 }
                 let start = node.child[i] as usize;
-                for [a, b, c] in &self.corners[start..start + count] {
+                for entry in start..start + count {
+                    let [a, b, c] = &self.corners[self.triangle_of(entry)];
                     let t = cross(sub(*b, *a), sub(*c, *a));
                     // "Not positive", NaN included, exactly as the caller's full test
                     // asks it (a zero normal has no say there either).
