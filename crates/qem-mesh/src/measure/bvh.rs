@@ -24,7 +24,7 @@ use super::{cross, length, sub, triangle_distance2, P3};
 use crate::input::IndexedMesh;
 use rayon::prelude::*;
 
-/// Triangles per leaf: small leaves keep the exact tests few, large enough to keep the
+/// Entries (triangles, or pieces of them) per leaf: small leaves keep the exact tests few, large enough to keep the
 /// tree shallow.
 const LEAF_SIZE: usize = 4;
 
@@ -134,9 +134,9 @@ pub(super) struct WideNode {
     /// facing-away search (empty when all its triangles have zero area).
     pub normal_lo: [[f32; WIDTH]; 3],
     pub normal_hi: [[f32; WIDTH]; 3],
-    /// An inner child: its node's index. A leaf child: the first of its triangles.
+    /// An inner child: its node's index. A leaf child: its first leaf entry.
     pub child: [u32; WIDTH],
-    /// A leaf child: how many triangles (1..=LEAF_SIZE); an inner child: 0.
+    /// A leaf child: how many entries (1..=LEAF_SIZE); an inner child: 0.
     pub leaf_count: [u8; WIDTH],
     /// How many children are used (the first ones); the others have empty boxes.
     pub lanes: u8,
@@ -218,9 +218,10 @@ impl<T: Copy + Default> NodeStack<T> {
 /// queries: a node is skipped only when its box is farther than the best distance found
 /// so far, so the answer is the true minimum over all triangles.
 ///
-/// Built top-down by splitting the triangles at the median centroid along the longest
-/// axis of the centroids' box (ties broken by triangle index, so the tree is
-/// deterministic), then stored four children a node (see the module docs).
+/// Built top-down by splitting the leaf entries (triangles, or pieces of long thin
+/// ones) at the median centroid along the longest axis of the centroids' box (ties
+/// broken by entry number, so the tree is deterministic), then stored four children a
+/// node (see the module docs).
 #[derive(Clone, Debug)]
 pub struct TriangleBvh {
     /// The wide tree; node 0 is the root. Empty when there are no triangles.
@@ -550,7 +551,7 @@ fn canonical(p: P3) -> P3 {
 
 /// [`build`] with a leaf entry per triangle.
 fn build_whole(corners: &mut [[P3; 3]]) -> (Vec<WideNode>, Vec<u32>) {
-    // The centroids, kept for the split only (24 bytes per triangle): recomputing them
+    // The centroids, kept for the split only (24 bytes per entry): recomputing them
     // inside the median selection's comparisons made the dragon's index build about
     // 0.3 s slower.
     let centroids: Vec<P3> = corners
@@ -578,7 +579,7 @@ fn build_whole(corners: &mut [[P3; 3]]) -> (Vec<WideNode>, Vec<u32>) {
 /// Triangles are numbered in the order the leaves first meet them.
 fn build_in_pieces(corners: &mut [[P3; 3]], counts: &[u8]) -> (Vec<WideNode>, Vec<u32>, Vec<u32>) {
     // first[t]: the number of triangle t's first piece; pieces are numbered triangle
-    // by triangle (u32: the budget keeps their count within twice the triangles').
+    // by triangle (u32: the budget keeps their count within PIECES_PER_TRIANGLE times the triangles').
     let mut first = Vec::with_capacity(counts.len() + 1);
     let mut total = 0u32;
     for &k in counts {
@@ -644,10 +645,10 @@ fn move_to_slots(corners: &mut [[P3; 3]], slots: &[u32]) {
 /// cover the parallel path; raise both together.
 const PARALLEL_PARTITION: usize = 1 << 14;
 
-/// Reorders `order` (triangle numbers) so that every range of the binary tree holds
-/// its triangles: a range of more than [`LEAF_SIZE`] is split at its middle, the
-/// lower half holding the triangles whose centroids come first along the longest axis
-/// of the range's centroid box (by coordinate, then by number).
+/// Reorders `order` (entry numbers: triangles, or pieces of them) so that every range
+/// of the binary tree holds its entries: a range of more than [`LEAF_SIZE`] is split at
+/// its middle, the lower half holding the entries whose centroids come first along the
+/// longest axis of the range's centroid box (by coordinate, then by number).
 ///
 /// Each range is split by one selection on its own elements, whichever core does it
 /// and whenever, so the result is the same with any number of threads.
@@ -696,7 +697,7 @@ fn wide_nodes(n: usize) -> Vec<WideNode> {
         return nodes;
     }
     nodes.push(WideNode::EMPTY);
-    // (wide node, its range of triangles)
+    // (wide node, its range of entries)
     let mut stack = vec![(0usize, 0usize, n)];
     while let Some((w, start, end)) = stack.pop() {
         // The children's ranges: the quarters of a range, a half where the half is a
