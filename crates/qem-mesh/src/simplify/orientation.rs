@@ -46,6 +46,20 @@ const QUICK_RADIUS_FACTOR: f64 = 1.0 + 1e-9;
 /// A face without a hint in [`InputSurface`]'s table.
 const NO_HINT: u32 = u32::MAX;
 
+/// What the quick tests of [`InputSurface::agrees`] found.
+enum Quick {
+    /// The face agrees; `settled` is the triangle to become its hint, if any.
+    Agrees { settled: Option<u32> },
+    /// Only the full test can tell; `known2` bounds the nearest squared distance.
+    Undecided { known2: Option<f64> },
+}
+
+/// A face's centroid and (unnormalised) normal.
+fn centroid_and_normal(corners: [DVec3; 3]) -> (DVec3, DVec3) {
+    let normal = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
+    ((corners[0] + corners[1] + corners[2]) / 3.0, normal)
+}
+
 /// The input surface, indexed for nearest-triangle queries, in normalised units.
 #[derive(Debug)]
 pub(super) struct InputSurface {
@@ -145,35 +159,16 @@ impl InputSurface {
         corners: [DVec3; 3],
         neighbour_hint: &mut Option<u32>,
     ) -> bool {
-        let normal = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
-        let centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
-        let previous = *neighbour_hint;
-        let hint = self.hint(face).or(previous);
-        *neighbour_hint = hint;
-        let mut known2 = hint.and_then(|h| self.bvh.distance_squared_to(centroid.to_array(), h));
-        if self.quick_test(centroid, normal, known2) {
-            return true;
-        }
-        // Before the full test, the quick test once more with the triangle the face
-        // checked before this one settled on, when it is nearer than this face's own
-        // hint. Why: a contraction can move a face far from the input triangle it
-        // remembers (a fan's centre merging into its rim moves every fan face across
-        // the cap), so its own hint's ball reaches faces at right angles and the quick
-        // test fails; the neighbour's nearest triangle, found a moment ago next to
-        // the same moved vertex, is usually close. Either ball gives the same answer
-        // (see above); only the work differs.
-        if let Some(p) = previous.filter(|&p| Some(p) != hint) {
-            let p2 = self.bvh.distance_squared_to(centroid.to_array(), p);
-            if p2.is_some_and(|p2| known2.is_none_or(|u2| p2 < u2)) {
-                known2 = p2;
-                if self.quick_test(centroid, normal, known2) {
-                    self.set_hint(face, p);
-                    *neighbour_hint = Some(p);
-                    return true;
+        let (centroid, normal) = centroid_and_normal(corners);
+        let known2 = match self.quick_verdict(face, centroid, normal, neighbour_hint) {
+            Quick::Agrees { settled } => {
+                if let Some(t) = settled {
+                    self.set_hint(face, t);
                 }
+                return true;
             }
-        }
-
+            Quick::Undecided { known2 } => known2,
+        };
         let nearest = self.bvh.nearest_triangles_within(
             centroid.to_array(),
             known2.unwrap_or(f64::INFINITY),
@@ -196,6 +191,63 @@ impl InputSurface {
         })
     }
 
+    /// The quick tests of [`agrees`](Self::agrees) alone, without touching the hints
+    /// (so many faces can be asked at once on several cores): `Some` when they show that
+    /// the face agrees, holding the triangle that should become its hint, if any (the
+    /// caller may give it with [`set_hint`](Self::set_hint), or not: hints change the
+    /// work, never the answers); `None` when only the full test can tell.
+    #[inline]
+    pub fn agrees_quickly(
+        &self,
+        face: usize,
+        corners: [DVec3; 3],
+        neighbour_hint: &mut Option<u32>,
+    ) -> Option<Option<u32>> {
+        let (centroid, normal) = centroid_and_normal(corners);
+        match self.quick_verdict(face, centroid, normal, neighbour_hint) {
+            Quick::Agrees { settled } => Some(settled),
+            Quick::Undecided { .. } => None,
+        }
+    }
+
+    /// The quick tests of [`agrees`](Self::agrees): with the face's hint, then with
+    /// the neighbour's when it is nearer.
+    #[inline]
+    fn quick_verdict(
+        &self,
+        face: usize,
+        centroid: DVec3,
+        normal: DVec3,
+        neighbour_hint: &mut Option<u32>,
+    ) -> Quick {
+        let previous = *neighbour_hint;
+        let hint = self.hint(face).or(previous);
+        *neighbour_hint = hint;
+        let mut known2 = hint.and_then(|h| self.bvh.distance_squared_to(centroid.to_array(), h));
+        if self.quick_test(centroid, normal, known2) {
+            return Quick::Agrees { settled: None };
+        }
+        // Before the full test, the quick test once more with the triangle the face
+        // checked before this one settled on, when it is nearer than this face's own
+        // hint. Why: a contraction can move a face far from the input triangle it
+        // remembers (a fan's centre merging into its rim moves every fan face across
+        // the cap), so its own hint's ball reaches faces at right angles and the quick
+        // test fails; the neighbour's nearest triangle, found a moment ago next to
+        // the same moved vertex, is usually close. Either ball gives the same answer
+        // (see above); only the work differs.
+        if let Some(p) = previous.filter(|&p| Some(p) != hint) {
+            let p2 = self.bvh.distance_squared_to(centroid.to_array(), p);
+            if p2.is_some_and(|p2| known2.is_none_or(|u2| p2 < u2)) {
+                known2 = p2;
+                if self.quick_test(centroid, normal, known2) {
+                    *neighbour_hint = Some(p);
+                    return Quick::Agrees { settled: Some(p) };
+                }
+            }
+        }
+        Quick::Undecided { known2 }
+    }
+
     /// The quick test of [`agrees`](Self::agrees): with `known2` a squared distance
     /// from `centroid` to some input triangle, whether no triangle within the ball it
     /// bounds faces away from `normal` (false also when there is no such bound).
@@ -212,7 +264,7 @@ impl InputSurface {
     }
 
     /// Makes `t` the hint of `face`.
-    fn set_hint(&mut self, face: usize, t: u32) {
+    pub fn set_hint(&mut self, face: usize, t: u32) {
         if self.hints.len() <= face {
             self.hints.resize(face + 1, NO_HINT);
         }
