@@ -54,6 +54,14 @@ enum Quick {
     Undecided { known2: Option<f64> },
 }
 
+/// What [`InputSurface::agrees_quickly`] found.
+pub(super) enum QuickAnswer {
+    /// The face agrees; `settled` is the triangle to become its hint, if any.
+    Agrees { settled: Option<u32> },
+    /// Only the full test of [`InputSurface::agrees`] can tell.
+    Undecided,
+}
+
 /// A face's centroid and (unnormalised) normal.
 fn centroid_and_normal(corners: [DVec3; 3]) -> (DVec3, DVec3) {
     let normal = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
@@ -68,10 +76,12 @@ pub(super) struct InputSurface {
     near: Vec<u32>,
     /// Per face, an input triangle near it: at first the face's own input triangle,
     /// then the nearest one at the face's last full test, or the previous face's
-    /// triangle when a quick test with it passed; [`NO_HINT`] when there is none yet. Its distance to the face's new centroid bounds the nearest distance
-    /// from above, which is what the quick test needs (and lets the full test prune
-    /// from its first node). Any triangle would give the same answers; a nearer one
-    /// gives them sooner.
+    /// triangle when a quick test with it passed (in the pass-based order, also as a
+    /// speculation found it, given with [`set_hint`](Self::set_hint)); [`NO_HINT`]
+    /// when there is none yet. Its distance to the face's new centroid bounds the
+    /// nearest distance from above, which is what the quick test needs (and lets the
+    /// full test prune from its first node). Any triangle would give the same answers;
+    /// a nearer one gives them sooner.
     ///
     /// Indexed by a face number the caller chooses: the slot index of a store face in
     /// the greedy order, the triangle's index in the pass-based one.
@@ -192,21 +202,21 @@ impl InputSurface {
     }
 
     /// The quick tests of [`agrees`](Self::agrees) alone, without touching the hints
-    /// (so many faces can be asked at once on several cores): `Some` when they show that
-    /// the face agrees, holding the triangle that should become its hint, if any (the
-    /// caller may give it with [`set_hint`](Self::set_hint), or not: hints change the
-    /// work, never the answers); `None` when only the full test can tell.
+    /// (so many faces can be asked at once on several cores). When they show that the
+    /// face agrees, the answer holds the triangle that should become its hint, if any:
+    /// the caller may give it with [`set_hint`](Self::set_hint), or not (hints change
+    /// the work, never the answers).
     #[inline]
     pub fn agrees_quickly(
         &self,
         face: usize,
         corners: [DVec3; 3],
         neighbour_hint: &mut Option<u32>,
-    ) -> Option<Option<u32>> {
+    ) -> QuickAnswer {
         let (centroid, normal) = centroid_and_normal(corners);
         match self.quick_verdict(face, centroid, normal, neighbour_hint) {
-            Quick::Agrees { settled } => Some(settled),
-            Quick::Undecided { .. } => None,
+            Quick::Agrees { settled } => QuickAnswer::Agrees { settled },
+            Quick::Undecided { .. } => QuickAnswer::Undecided,
         }
     }
 
