@@ -936,13 +936,7 @@ impl PassEngine {
             if corners.contains(&a) && corners.contains(&b) {
                 continue;
             }
-            let new = corners.map(|c| {
-                if c == a || c == b {
-                    moved
-                } else {
-                    self.position[c as usize]
-                }
-            });
+            let new = moved_corners(&self.position, corners, [a, b], moved);
             // Only the quick tests: a full search here would start from the hints as
             // they were, which the attempts before this one may have moved on (on CAD
             // meshes, where full searches are common and dear, asking them here made
@@ -1164,13 +1158,7 @@ impl PassEngine {
                 }
                 *asked_again += 1;
             }
-            let new = corners.map(|c| {
-                if c == a || c == b {
-                    moved
-                } else {
-                    self.position[c as usize]
-                }
-            });
+            let new = moved_corners(&self.position, corners, [a, b], moved);
             surface.agrees(x.triangle as usize, new, &mut neighbour_hint)
         })
     }
@@ -1307,6 +1295,23 @@ fn border_neighbours(v: u32, around: &[Around]) -> SmallVec<[u32; 8]> {
         }
     }
     listed_once(&mut ends[..n])
+}
+
+/// The positions of a triangle's `corners` once the pair `ends` is contracted to
+/// `moved` (normalised units): either end goes to `moved`, the others stay.
+fn moved_corners(
+    position: &[DVec3],
+    corners: [u32; 3],
+    ends: [u32; 2],
+    moved: DVec3,
+) -> [DVec3; 3] {
+    corners.map(|c| {
+        if ends.contains(&c) {
+            moved
+        } else {
+            position[c as usize]
+        }
+    })
 }
 
 /// The numbers that occur exactly once in `ends` (sorted in place), in increasing
