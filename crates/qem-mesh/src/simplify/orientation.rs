@@ -46,20 +46,13 @@ const QUICK_RADIUS_FACTOR: f64 = 1.0 + 1e-9;
 /// A face without a hint in [`InputSurface`]'s table.
 const NO_HINT: u32 = u32::MAX;
 
-/// What the quick tests of [`InputSurface::agrees`] found.
-enum Quick {
+/// What the quick tests of [`InputSurface::agrees`] found (also the answer of
+/// [`InputSurface::agrees_quickly`]).
+pub(super) enum Quick {
     /// The face agrees; `settled` is the triangle to become its hint, if any.
     Agrees { settled: Option<u32> },
     /// Only the full test can tell; `known2` bounds the nearest squared distance.
     Undecided { known2: Option<f64> },
-}
-
-/// What [`InputSurface::agrees_quickly`] found.
-pub(super) enum QuickAnswer {
-    /// The face agrees; `settled` is the triangle to become its hint, if any.
-    Agrees { settled: Option<u32> },
-    /// Only the full test of [`InputSurface::agrees`] can tell.
-    Undecided,
 }
 
 /// A face's centroid and (unnormalised) normal.
@@ -212,12 +205,9 @@ impl InputSurface {
         face: usize,
         corners: [DVec3; 3],
         neighbour_hint: &mut Option<u32>,
-    ) -> QuickAnswer {
+    ) -> Quick {
         let (centroid, normal) = centroid_and_normal(corners);
-        match self.quick_verdict(face, centroid, normal, neighbour_hint) {
-            Quick::Agrees { settled } => QuickAnswer::Agrees { settled },
-            Quick::Undecided { .. } => QuickAnswer::Undecided,
-        }
+        self.quick_verdict(face, centroid, normal, neighbour_hint)
     }
 
     /// The quick tests of [`agrees`](Self::agrees): with the face's hint, then with

@@ -49,7 +49,7 @@ use super::engine::{place_merged, Counters, Settings};
 use super::observer::{Contraction, Observer, Progress};
 use super::options::QuadricMode;
 use super::options::{BoundaryMode, SimplifyOptions};
-use super::orientation::{InputSurface, QuickAnswer};
+use super::orientation::{InputSurface, Quick};
 use super::pass_exact::{shorter_list, PassExact};
 use super::report::StopReason;
 use super::waivers::{penalised, Waivers};
@@ -941,7 +941,7 @@ impl PassEngine {
             // they were, which the attempts before this one may have moved on (on CAD
             // meshes, where full searches are common and dear, asking them here made
             // the run twice as slow); the attempt asks it with the hints of its time.
-            let QuickAnswer::Agrees { settled } =
+            let Quick::Agrees { settled } =
                 surface.agrees_quickly(x.triangle as usize, new, &mut neighbour_hint)
             else {
                 break;
