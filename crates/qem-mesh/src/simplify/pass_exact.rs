@@ -52,10 +52,11 @@ pub(super) struct PassExact {
 }
 
 impl PassExact {
-    /// No plane yet, for `triangle_count` triangles and `vertex_count` vertices.
-    pub fn new(triangle_count: usize, vertex_count: usize) -> Self {
+    /// No plane yet, for `vertex_count` vertices (the face planes come with
+    /// [`set_face_planes`](Self::set_face_planes)).
+    pub fn new(vertex_count: usize) -> Self {
         PassExact {
-            face_planes: vec![WeightedPlane::NONE; triangle_count],
+            face_planes: Vec::new(),
             border_planes: Vec::new(),
             segments: Vec::new(),
             merged_into: (0..vertex_count as u32).collect(),
@@ -64,9 +65,11 @@ impl PassExact {
         }
     }
 
-    /// Records the face plane of triangle `t`.
-    pub fn set_face_plane(&mut self, t: u32, plane: WeightedPlane) {
-        self.face_planes[t as usize] = plane;
+    /// Records every triangle's face plane, by triangle index; before any border plane
+    /// is added (a border plane's source number counts the triangles).
+    pub fn set_face_planes(&mut self, planes: Vec<WeightedPlane>) {
+        debug_assert!(self.border_planes.is_empty());
+        self.face_planes = planes;
     }
 
     /// The quadric of triangle `t`'s face plane.
@@ -201,9 +204,8 @@ mod tests {
     /// become one vertex is forgotten.
     #[test]
     fn segments_follow_merges_and_vanish_when_their_ends_meet() {
-        let mut e = PassExact::new(2, 6);
-        e.set_face_plane(0, plane(1.0));
-        e.set_face_plane(1, plane(2.0));
+        let mut e = PassExact::new(6);
+        e.set_face_planes(vec![plane(1.0), plane(2.0)]);
         let border = Quadric::from_plane(DVec3::X, -3.0);
         e.add_border_plane(4, 5, border);
         // Triangle 0 on 0 1 2 collapses as 1 goes into 0: a segment 0–2.

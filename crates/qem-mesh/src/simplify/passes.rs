@@ -254,12 +254,12 @@ impl PassEngine {
             since_report: 0,
             input_surface: None,
             waivers: Waivers::new(n),
-            exact: (options.quadrics == QuadricMode::Exact)
-                .then(|| PassExact::new(cleaned.triangles.len(), n)),
+            exact: (options.quadrics == QuadricMode::Exact).then(|| PassExact::new(n)),
             position,
         };
-        let area_offset = engine.sum_face_planes(options);
+        // The incident lists first: the quadrics are summed along them.
         engine.list_incident_triangles();
+        let area_offset = engine.sum_face_planes(options);
         engine.initialise_boundary(options, area_offset);
         for &i in locked {
             if let Some(l) = engine.locked.get_mut(i as usize) {
@@ -285,9 +285,10 @@ impl PassEngine {
         t.map(|c| self.position[c as usize])
     }
 
-    /// Each face's normal and plane (computed on both cores), summed into its vertices
-    /// in triangle order, so the sums' bits do not depend on the thread count. Returns
-    /// the weighting's constant added to face areas (`None`: unit weights).
+    /// Each face's normal and plane, and each vertex's quadric summed along its incident
+    /// list (both on the thread pool; each sum in a fixed order, so the bits do not
+    /// depend on the thread count). Needs the incident lists. Returns the weighting's
+    /// constant added to face areas (`None`: unit weights).
     fn sum_face_planes(&mut self, options: &SimplifyOptions) -> Option<f64> {
         let areas: f64 = self
             .live
@@ -303,32 +304,52 @@ impl PassEngine {
             areas / self.live.len() as f64
         };
         let area_offset = options.weighting.area_offset(mean_area);
-        // Planes rather than quadrics collected (40 bytes a triangle instead of 80, at
-        // the setup's memory peak); each quadric is made as it is summed. (With exact
-        // quadrics the planes are also kept for the run, 40 bytes a triangle more.)
-        let planes: Vec<(DVec3, WeightedPlane)> = self
-            .live
-            .par_iter()
-            .map(|&t| {
-                let [pa, pb, pc] = self.corners(self.triangles[t as usize]);
-                let plane = match area_offset {
+        // Each triangle's normal and weighted plane, by triangle index, on both cores;
+        // a triangle that is not live keeps a zero normal (never read) and no plane.
+        // Planes rather than quadrics kept (40 bytes a triangle instead of 80, at the
+        // setup's memory peak); with exact quadrics the planes are kept for the run.
+        let count = self.triangles.len();
+        let mut normals = vec![DVec3::ZERO; count];
+        let mut planes = vec![WeightedPlane::NONE; count];
+        let is_live = (self.live.len() < count).then(|| {
+            let mut is_live = vec![false; count];
+            for &t in &self.live {
+                is_live[t as usize] = true;
+            }
+            is_live
+        });
+        let (position, triangles) = (&self.position, &self.triangles);
+        normals
+            .par_iter_mut()
+            .zip(planes.par_iter_mut())
+            .enumerate()
+            .filter(|(t, _)| is_live.as_ref().is_none_or(|live| live[*t]))
+            .for_each(|(t, (normal, plane))| {
+                let [pa, pb, pc] = triangles[t].map(|c| position[c as usize]);
+                *plane = match area_offset {
                     Some(extra) => WeightedPlane::from_triangle_area_plus(pa, pb, pc, extra),
                     None => WeightedPlane::from_triangle_unweighted(pa, pb, pc),
                 };
-                ((pb - pa).cross(pc - pa), plane)
-            })
-            .collect();
-        // A triangle that is not live never has its normal read.
-        self.original_normals = vec![DVec3::ZERO; self.triangles.len()];
-        for (&t, &(normal, plane)) in self.live.iter().zip(&planes) {
-            self.original_normals[t as usize] = normal;
-            let q = plane.quadric();
-            for c in self.triangles[t as usize] {
-                self.quadric[c as usize] += q;
-            }
-            if let Some(exact) = &mut self.exact {
-                exact.set_face_plane(t, plane);
-            }
+                *normal = (pb - pa).cross(pc - pa);
+            });
+        // Each vertex's quadric, summed over its live triangles in the order of
+        // `live` (the order of its incident list): the bits the sum in that order gives,
+        // whatever the thread count. (Made from the plane at each corner rather than
+        // kept per triangle: 80 bytes a triangle saved.)
+        let (first, incident) = (&self.first, &self.incident);
+        self.quadric
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(v, quadric)| {
+                let mut sum = Quadric::default();
+                for &t in &incident[first[v] as usize..first[v + 1] as usize] {
+                    sum += planes[t as usize].quadric();
+                }
+                *quadric = sum;
+            });
+        self.original_normals = normals;
+        if let Some(exact) = &mut self.exact {
+            exact.set_face_planes(planes);
         }
         area_offset
     }
