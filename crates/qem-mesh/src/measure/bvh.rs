@@ -248,27 +248,66 @@ impl TriangleBvh {
     /// [`new`](Self::new), and where each triangle went: `slots[i]` is the index (for
     /// [`corners`](Self::corners)) of the `i`-th triangle of `mesh` with valid indices.
     pub fn with_slots(mesh: &IndexedMesh) -> (TriangleBvh, Vec<u32>) {
-        let corners: Vec<[P3; 3]> = mesh
+        Self::from_triangles(mesh, |p| p)
+    }
+
+    /// The index over the triangles of `mesh` with valid indices, each corner mapped
+    /// through `to_index` first (which should be cheap: it runs several times per
+    /// corner), and where each triangle went (as [`with_slots`](Self::with_slots)).
+    ///
+    /// Why from the mesh rather than a list of corners: the corners are gathered
+    /// straight into leaf order once the tree's order is known (on both cores), where a
+    /// list would be gathered first (on one) and then permuted in place. On a
+    /// 4M-triangle mesh that is 288 MB written once instead of twice.
+    pub fn from_triangles(
+        mesh: &IndexedMesh,
+        to_index: impl Fn(P3) -> P3 + Sync,
+    ) -> (TriangleBvh, Vec<u32>) {
+        let n = mesh.positions.len();
+        let all_valid = mesh
             .triangles
-            .iter()
-            .filter_map(|t| {
-                let p = |i: u32| mesh.positions.get(i as usize).copied();
-                Some([p(t[0])?, p(t[1])?, p(t[2])?])
+            .par_iter()
+            .all(|t| t.iter().all(|&i| (i as usize) < n));
+        if all_valid {
+            let (triangles, positions) = (&mesh.triangles, &mesh.positions);
+            Self::from_corner_fn(triangles.len(), |t| {
+                triangles[t].map(|i| to_index(positions[i as usize]))
             })
-            .collect();
-        Self::from_corners(corners)
+        } else {
+            // Left out, as documented; a validated mesh never comes this way.
+            let corners: Vec<[P3; 3]> = mesh
+                .triangles
+                .iter()
+                .filter_map(|t| {
+                    let p = |i: u32| mesh.positions.get(i as usize).map(|&p| to_index(p));
+                    Some([p(t[0])?, p(t[1])?, p(t[2])?])
+                })
+                .collect();
+            Self::from_corners(corners)
+        }
     }
 
     /// The index over these triangles (given by their corners), and where each went:
-    /// `slots[i]` is the index (for [`corners`](Self::corners)) of `corners[i]`. Takes
-    /// the corners by value and reorders them in place, so the build needs no second
-    /// copy (a large mesh's corners are 72 bytes per triangle). Triangles are numbered
-    /// with `u32`: at most `u32::MAX` of them are indexed (about 300 GB of corners), the
-    /// rest are left out. Corners should be finite (as a validated mesh's are): a
-    /// triangle with a NaN corner is never found by the searches.
-    pub fn from_corners(mut corners: Vec<[P3; 3]>) -> (TriangleBvh, Vec<u32>) {
-        corners.truncate(u32::MAX as usize);
-        let (nodes, slots, root, pieces) = build(&mut corners);
+    /// `slots[i]` is the index (for [`corners`](Self::corners)) of `corners[i]`.
+    /// Triangles are numbered with `u32`: at most `u32::MAX` of them are indexed (about
+    /// 300 GB of corners), the rest are left out. Corners should be finite (as a
+    /// validated mesh's are): a triangle with a NaN corner is never found by the
+    /// searches. (The index holds its own copy of the corners, in leaf order; a mesh
+    /// is better given to [`from_triangles`](Self::from_triangles), which needs no
+    /// list.)
+    pub fn from_corners(corners: Vec<[P3; 3]>) -> (TriangleBvh, Vec<u32>) {
+        Self::from_corner_fn(corners.len(), |t| corners[t])
+    }
+
+    /// The index over `count` triangles, triangle `t` having corners `corners_of(t)`
+    /// (asked several times per triangle, from several threads: it must give the same
+    /// bits each time), and where each went (as [`from_corners`](Self::from_corners)).
+    fn from_corner_fn(
+        count: usize,
+        corners_of: impl Fn(usize) -> [P3; 3] + Sync,
+    ) -> (TriangleBvh, Vec<u32>) {
+        let count = count.min(u32::MAX as usize);
+        let (nodes, corners, slots, root, pieces) = build(count, &corners_of);
         let scale = (0..3)
             .map(|k| root.lo[k].abs().max(root.hi[k].abs()))
             .fold(0.0, f64::max);
@@ -504,8 +543,9 @@ impl TriangleBvh {
     }
 }
 
-/// The tree over `corners` (renumbered in place, see [`TriangleBvh::corners`]), node 0
-/// the root, every node after its parent; where each triangle went (`slots[i]` is the
+/// The tree over the `count` triangles whose corners `corners_of` gives (those
+/// corners returned in leaf order, see [`TriangleBvh::corners`]), node 0 the root,
+/// every node after its parent; where each triangle went (`slots[i]` is the
 /// new index of the triangle that was at `i`); the box of all the corners; and the
 /// triangle of each leaf entry when some triangle is indexed in pieces (see
 /// [`pieces`]).
@@ -517,29 +557,43 @@ impl TriangleBvh {
 /// half, where the half is a leaf). Built straight into wide nodes, so the build never
 /// holds a binary node per range (56 bytes each, about 134 MB on the 4M sphere).
 ///
+/// What [`build`] returns: the nodes, the corners in leaf order, where each triangle
+/// went, the root's box, and the pieces' triangles (when there are pieces).
+type Built = (
+    Vec<WideNode>,
+    Vec<[P3; 3]>,
+    Vec<u32>,
+    Aabb,
+    Option<Vec<u32>>,
+);
+
 /// Four steps, so that none reads corners out of order: [`partition`] puts every
-/// entry in its leaf (on both cores), the corners move to leaf order, [`wide_nodes`]
-/// lays out the nodes (which needs only the range sizes), and [`fill_boxes`] fills in
-/// the boxes bottom-up. Why: building top-down with each range's box computed as its
-/// split was made read every triangle's 72 bytes of corners at random, once per level;
-/// that was most of the index build, then the longer half of the simplifier's setup.
-fn build(corners: &mut [[P3; 3]]) -> (Vec<WideNode>, Vec<u32>, Aabb, Option<Vec<u32>>) {
+/// entry in its leaf (on both cores), the corners are gathered in leaf order (on both
+/// cores), [`wide_nodes`] lays out the nodes (which needs only the range sizes), and
+/// [`fill_boxes`] fills in the boxes bottom-up. Why: building top-down with each
+/// range's box computed as its split was made read every triangle's 72 bytes of
+/// corners at random, once per level; that was most of the index build, then the
+/// longer half of the simplifier's setup.
+fn build(count: usize, corners_of: &(impl Fn(usize) -> [P3; 3] + Sync)) -> Built {
     let mut root_bounds = Aabb::EMPTY;
-    for corner in corners.iter().flatten() {
-        root_bounds.grow(*corner);
+    for t in 0..count {
+        for corner in corners_of(t) {
+            root_bounds.grow(corner);
+        }
     }
     let extent = sub(root_bounds.hi, root_bounds.lo);
-    let (nodes, slots, pieces) = match pieces::piece_counts(corners, length(extent)) {
-        None => {
-            let (nodes, slots) = build_whole(corners);
-            (nodes, slots, None)
-        }
-        Some(counts) => {
-            let (nodes, slots, pieces) = build_in_pieces(corners, &counts);
-            (nodes, slots, Some(pieces))
-        }
-    };
-    (nodes, slots, root_bounds, pieces)
+    let (nodes, corners, slots, pieces) =
+        match pieces::piece_counts(count, corners_of, length(extent)) {
+            None => {
+                let (nodes, corners, slots) = build_whole(count, corners_of);
+                (nodes, corners, slots, None)
+            }
+            Some(counts) => {
+                let (nodes, corners, slots, pieces) = build_in_pieces(corners_of, &counts);
+                (nodes, corners, slots, Some(pieces))
+            }
+        };
+    (nodes, corners, slots, root_bounds, pieces)
 }
 
 /// A NaN coordinate (from infinite or NaN corners, which callers should not pass)
@@ -549,36 +603,49 @@ fn canonical(p: P3) -> P3 {
     p.map(|x| if x.is_nan() { f64::NAN } else { x })
 }
 
-/// [`build`] with a leaf entry per triangle.
-fn build_whole(corners: &mut [[P3; 3]]) -> (Vec<WideNode>, Vec<u32>) {
+/// [`build`] with a leaf entry per triangle: the nodes, the corners in leaf order and
+/// where each triangle went.
+fn build_whole(
+    count: usize,
+    corners_of: &(impl Fn(usize) -> [P3; 3] + Sync),
+) -> (Vec<WideNode>, Vec<[P3; 3]>, Vec<u32>) {
     // The centroids, kept for the split only: recomputing them inside the median
     // selection's comparisons made the dragon's index build about 0.3 s slower.
-    let mut order: Vec<Split> = corners
-        .par_iter()
-        .enumerate()
-        .map(|(entry, c)| Split {
-            centroid: canonical([0, 1, 2].map(|k| (c[0][k] + c[1][k] + c[2][k]) / 3.0)),
-            entry: entry as u32,
+    let mut order: Vec<Split> = (0..count)
+        .into_par_iter()
+        .map(|entry| {
+            let c = corners_of(entry);
+            Split {
+                centroid: canonical([0, 1, 2].map(|k| (c[0][k] + c[1][k] + c[2][k]) / 3.0)),
+                entry: entry as u32,
+            }
         })
         .collect();
     partition(&mut order);
+    let corners: Vec<[P3; 3]> = order
+        .par_iter()
+        .map(|split| corners_of(split.entry as usize))
+        .collect();
     let mut slots = vec![0u32; order.len()];
     for (slot, split) in order.iter().enumerate() {
         slots[split.entry as usize] = slot as u32;
     }
     drop(order);
-    move_to_slots(corners, &slots);
     let mut nodes = wide_nodes(corners.len());
     fill_boxes(&mut nodes, |entry| {
         let c = &corners[entry];
         (*c, pieces::piece_box(c, 0, 1))
     });
-    (nodes, slots)
+    (nodes, corners, slots)
 }
 
 /// [`build`] with triangle `t` cut into `counts[t]` pieces: a leaf entry per piece.
-/// Triangles are numbered in the order the leaves first meet them.
-fn build_in_pieces(corners: &mut [[P3; 3]], counts: &[u8]) -> (Vec<WideNode>, Vec<u32>, Vec<u32>) {
+/// Triangles are numbered in the order the leaves first meet them. Returns the nodes,
+/// the corners in that order, where each triangle went and each leaf entry's triangle.
+fn build_in_pieces(
+    corners_of: &(impl Fn(usize) -> [P3; 3] + Sync),
+    counts: &[u8],
+) -> (Vec<WideNode>, Vec<[P3; 3]>, Vec<u32>, Vec<u32>) {
     // first[t]: the number of triangle t's first piece; pieces are numbered triangle
     // by triangle (u32: the budget keeps their count within PIECES_PER_TRIANGLE times the triangles').
     let mut first = Vec::with_capacity(counts.len() + 1);
@@ -596,11 +663,11 @@ fn build_in_pieces(corners: &mut [[P3; 3]], counts: &[u8]) -> (Vec<WideNode>, Ve
         .into_par_iter()
         .map(|entry| {
             let (t, j, k) = triangle_and_piece(entry);
-            let c = &corners[t];
+            let c = corners_of(t);
             let centroid = canonical(if k == 1 {
                 [0, 1, 2].map(|i| (c[0][i] + c[1][i] + c[2][i]) / 3.0)
             } else {
-                pieces::piece_centre(c, j, k)
+                pieces::piece_centre(&c, j, k)
             });
             Split { centroid, entry }
         })
@@ -608,38 +675,27 @@ fn build_in_pieces(corners: &mut [[P3; 3]], counts: &[u8]) -> (Vec<WideNode>, Ve
     partition(&mut splits);
     let order: Vec<u32> = splits.iter().map(|split| split.entry).collect();
     drop(splits);
-    let mut slots = vec![u32::MAX; corners.len()];
-    let mut next = 0u32;
+    let mut slots = vec![u32::MAX; counts.len()];
+    // by_slot[s]: the triangle numbered s, the inverse of `slots`.
+    let mut by_slot = Vec::with_capacity(counts.len());
     let mut leaf_triangles = Vec::with_capacity(order.len());
     for &entry in &order {
         let (t, _, _) = triangle_and_piece(entry);
         if slots[t] == u32::MAX {
-            slots[t] = next;
-            next += 1;
+            slots[t] = by_slot.len() as u32;
+            by_slot.push(t);
         }
         leaf_triangles.push(slots[t]);
     }
-    move_to_slots(corners, &slots);
+    let corners: Vec<[P3; 3]> = by_slot.par_iter().map(|&t| corners_of(t)).collect();
+    drop(by_slot);
     let mut nodes = wide_nodes(order.len());
     fill_boxes(&mut nodes, |entry| {
         let (_, j, k) = triangle_and_piece(order[entry]);
         let c = &corners[leaf_triangles[entry] as usize];
         (*c, pieces::piece_box(c, j, k))
     });
-    (nodes, slots, leaf_triangles)
-}
-
-/// Moves each triangle to its slot in place, cycle by cycle (`destination` follows the
-/// triangles as they move).
-fn move_to_slots(corners: &mut [[P3; 3]], slots: &[u32]) {
-    let mut destination = slots.to_vec();
-    for i in 0..corners.len() {
-        while destination[i] as usize != i {
-            let d = destination[i] as usize;
-            corners.swap(i, d);
-            destination.swap(i, d);
-        }
-    }
+    (nodes, corners, slots, leaf_triangles)
 }
 
 /// Ranges at least this long are split on both cores (below it, handing work to rayon
@@ -877,13 +933,11 @@ mod tests {
     #[test]
     fn the_node_count_is_exact() {
         for n in [0usize, 1, 4, 5, 9, 17, 100, 1000, 4097] {
-            let mut corners: Vec<[P3; 3]> = (0..n)
-                .map(|i| {
-                    let x = i as f64;
-                    [[x, 0.0, 0.0], [x, 1.0, 0.0], [x, 0.0, 1.0]]
-                })
-                .collect();
-            let (nodes, _, _, _) = build(&mut corners);
+            let corners_of = |i: usize| {
+                let x = i as f64;
+                [[x, 0.0, 0.0], [x, 1.0, 0.0], [x, 0.0, 1.0]]
+            };
+            let (nodes, ..) = build(n, &corners_of);
             assert_eq!(nodes.len(), wide_node_count(n), "{n} triangles");
         }
     }

@@ -64,11 +64,15 @@ fn box_extent(corners: &[P3; 3]) -> P3 {
     })
 }
 
-/// How many pieces each triangle is cut into (1: whole); `None` when no triangle is
-/// cut, which is the common case. `diagonal` is the length of the diagonal of the box
-/// of all the corners. Deterministic: a function of the corners alone.
-pub(super) fn piece_counts(corners: &[[P3; 3]], diagonal: f64) -> Option<Vec<u8>> {
-    let n = corners.len();
+/// How many pieces each of the `n` triangles (triangle `t` has corners
+/// `corners_of(t)`) is cut into (1: whole); `None` when no triangle is cut, which is
+/// the common case. `diagonal` is the length of the diagonal of the box of all the
+/// corners. Deterministic: a function of the corners alone.
+pub(super) fn piece_counts(
+    n: usize,
+    corners_of: &(impl Fn(usize) -> [P3; 3] + Sync),
+    diagonal: f64,
+) -> Option<Vec<u8>> {
     // The pieces are numbered with u32 too (see `TriangleBvh::from_corners`).
     if n < 2 || n.saturating_mul(PIECES_PER_TRIANGLE) > u32::MAX as usize {
         return None;
@@ -78,9 +82,9 @@ pub(super) fn piece_counts(corners: &[[P3; 3]], diagonal: f64) -> Option<Vec<u8>
     if !largest.is_finite() || largest <= 0.0 {
         return None;
     }
-    let counts: Vec<u8> = corners
-        .par_iter()
-        .map(|c| wanted_pieces(c, largest))
+    let counts: Vec<u8> = (0..n)
+        .into_par_iter()
+        .map(|t| wanted_pieces(&corners_of(t), largest))
         .collect();
     let wanted: usize = counts.iter().map(|&k| usize::from(k)).sum();
     if wanted == n {
@@ -253,16 +257,18 @@ mod tests {
         // As thin, but only 1 long: no larger than the others.
         corners.push([[0.0, 0.0, 2.0], [0.7, 0.7, 2.0], [0.7, 0.71, 2.0]]);
         let diagonal = (101f64.powi(2) + 70.01f64.powi(2) + 4.0).sqrt();
-        let counts = piece_counts(&corners, diagonal).expect("the long sliver is cut");
+        let counts_of =
+            |corners: &[[P3; 3]]| piece_counts(corners.len(), &|t| corners[t], diagonal);
+        let counts = counts_of(&corners).expect("the long sliver is cut");
         assert!(counts[..100].iter().all(|&k| k == 1));
         assert_eq!(counts[101], 1);
         assert!(counts[100] >= 2, "{}", counts[100]);
         // No thin triangle at all: nothing is cut.
-        assert_eq!(piece_counts(&corners[..100], diagonal), None);
+        assert_eq!(counts_of(&corners[..100]), None);
         // The long sliver with a NaN corner stays whole.
         let mut with_nan = corners[..100].to_vec();
         with_nan.push([[f64::NAN, 0.0, 1.0], [70.0, 70.0, 1.0], [70.0, 70.01, 1.0]]);
-        assert_eq!(piece_counts(&with_nan, diagonal), None);
+        assert_eq!(counts_of(&with_nan), None);
     }
 
     /// The budget caps the largest counts and keeps the sum within it.

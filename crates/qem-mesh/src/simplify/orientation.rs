@@ -86,24 +86,11 @@ impl InputSurface {
     /// each went (`slots[i]`: the index's number for the cleaned mesh's triangle `i`),
     /// for [`seed_hints`](Self::seed_hints).
     pub fn new(cleaned: &IndexedMesh, frame: &Frame) -> (InputSurface, Vec<u32>) {
-        // The corners in the loop's frame, gathered straight into the index (a
+        // The corners in the loop's frame, mapped as the index gathers them (a
         // normalised copy of the mesh first would cost its size again at the peak).
-        let to_loop = |i: u32| {
-            cleaned
-                .positions
-                .get(i as usize)
-                .map(|p| frame.to_normalized(DVec3::from_array(*p)).to_array())
-        };
-        // Reserved exactly: collected from a filter, the vector would grow by doubling
-        // (up to twice its size, while the other half of the setup holds its own).
-        let mut corners: Vec<[[f64; 3]; 3]> = Vec::with_capacity(cleaned.triangles.len());
-        corners.extend(
-            cleaned
-                .triangles
-                .iter()
-                .filter_map(|t| Some([to_loop(t[0])?, to_loop(t[1])?, to_loop(t[2])?])),
-        );
-        let (bvh, slots) = TriangleBvh::from_corners(corners);
+        let (bvh, slots) = TriangleBvh::from_triangles(cleaned, |p| {
+            frame.to_normalized(DVec3::from_array(p)).to_array()
+        });
         let surface = InputSurface {
             bvh,
             near: Vec::new(),
