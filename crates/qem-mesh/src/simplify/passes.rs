@@ -719,30 +719,33 @@ impl PassEngine {
     /// taken from the last pass's list instead of solved again: the same value, bit
     /// for bit. Late passes re-cost only a few percent of their edges this way.
     fn cost_edges(&mut self) {
+        // Written in place (the list taken out so the rest of `self` can be read
+        // meanwhile): a fresh list of costs each pass was 8 bytes per edge of new
+        // pages to fault in and then copy over.
+        let mut candidates = std::mem::take(&mut self.candidates);
         let this = &*self;
-        let costs: Vec<f64> = this
-            .candidates
-            .par_iter()
-            .map(|c| {
-                if let Some(cost) = this.last_cost(c.a, c.b) {
-                    return cost;
+        candidates.par_iter_mut().for_each(|c| {
+            c.cost = match this.last_cost(c.a, c.b) {
+                Some(cost) => cost,
+                None => {
+                    let (placed, _) = this.place(c.a, c.b);
+                    if placed.cost.is_nan() {
+                        f64::INFINITY
+                    } else {
+                        placed.cost
+                    }
                 }
-                let (placed, _) = this.place(c.a, c.b);
-                if placed.cost.is_nan() {
-                    f64::INFINITY
-                } else {
-                    placed.cost
-                }
-            })
-            .collect();
-        for (c, cost) in self.candidates.iter_mut().zip(costs) {
-            c.cost = cost;
-        }
+            };
+        });
+        self.candidates = candidates;
         // The unpenalised costs are the ones a later pass may reuse.
         self.last_listed.clone_from(&self.candidates);
         std::mem::swap(&mut self.last_listed_first, &mut self.listed_first);
         // Waived pairs are ranked at the greedy loop's penalty on their merged quadric.
         // (Few: a pass lists them first, then reads their quadrics.)
+        if self.waivers.is_empty() {
+            return;
+        }
         let waived: Vec<usize> = (0..self.candidates.len())
             .filter(|&i| {
                 let c = &self.candidates[i];

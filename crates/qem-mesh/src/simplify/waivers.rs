@@ -41,6 +41,11 @@ impl Waivers {
         }
     }
 
+    /// Whether no pair is waived.
+    pub fn is_empty(&self) -> bool {
+        self.partners.is_empty()
+    }
+
     /// Whether the pair `a`, `b` is waived.
     #[inline]
     pub fn contains(&self, a: u32, b: u32) -> bool {
