@@ -22,6 +22,7 @@
 mod checks;
 mod engine;
 mod exact;
+mod locality;
 mod observer;
 mod options;
 mod orientation;

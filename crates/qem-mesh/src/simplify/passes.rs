@@ -32,6 +32,10 @@
 //! greedy loop's penalty in later passes and then tried without it
 //! ([`super::waivers`]).
 //!
+//! The arrays are numbered in locality order ([`super::locality`]: vertices along a
+//! space-filling curve), so "in order" is also "near in space", whatever order the
+//! input came in; the output and the observer get the cleaned mesh's numbers back.
+//!
 //! If a pass contracts nothing, its batch grows fourfold (without the pairs already
 //! refused) until every edge has been tried; a pass that still contracts nothing ends
 //! the run.
@@ -46,6 +50,7 @@
 
 use super::checks::{moved_face_verdict, Rejection};
 use super::engine::{place_merged, Counters, Settings};
+use super::locality::{in_locality_order, Renumbered};
 use super::observer::{Contraction, Observer, Progress};
 use super::options::QuadricMode;
 use super::options::{BoundaryMode, SimplifyOptions};
@@ -136,6 +141,11 @@ pub(super) struct PassEngine {
     pub counters: Counters,
     /// World positions: a vertex that never moves keeps its input bits.
     world: Vec<[f64; 3]>,
+    /// The engine's arrays are in locality order ([`super::locality`]): for each
+    /// vertex, its number in the cleaned mesh (for the output and the observer).
+    vertex_from: Vec<u32>,
+    /// For each triangle, its number in the cleaned mesh.
+    triangle_from: Vec<u32>,
     /// Positions in the normalised frame.
     position: Vec<DVec3>,
     quadric: Vec<Quadric>,
@@ -204,30 +214,39 @@ impl PassEngine {
         locked: &[u32],
         options: &SimplifyOptions,
     ) -> Self {
-        let n = cleaned.positions.len();
-        let position: Vec<DVec3> = cleaned
+        let Renumbered {
+            mesh,
+            vertex_from,
+            vertex_to,
+            triangle_from,
+        } = in_locality_order(cleaned, &frame);
+        let n = mesh.positions.len();
+        let position: Vec<DVec3> = mesh
             .positions
             .par_iter()
             .map(|p| frame.to_normalized(DVec3::from_array(*p)))
             .collect();
+        // The triangles the store would keep: none with a repeated corner (it would
+        // count as live while having no area), only the first of each vertex set (the
+        // locality order keeps it first). Cleaning has dropped both when its passes
+        // were on; the search (16 bytes a triangle, at the setup's memory peak) runs
+        // only when they were off.
+        let live = if options.clean.drop_repeated_index && options.clean.drop_duplicates {
+            (0..mesh.triangles.len() as u32).collect()
+        } else {
+            kept_triangles(&mesh.triangles, n, &mut BuildStats::default())
+        };
         let mut engine = PassEngine {
             settings: Settings::new(options, &frame),
             frame,
             counters: Counters::default(),
-            world: cleaned.positions.clone(),
+            world: mesh.positions,
+            vertex_from,
+            triangle_from,
             quadric: vec![Quadric::default(); n],
             locked: vec![false; n],
-            triangles: cleaned.triangles.clone(),
-            // The triangles the store would keep: none with a repeated corner (it
-            // would count as live while having no area), only the first of each
-            // vertex set. Cleaning has dropped both when its passes were on; the
-            // search (16 bytes a triangle, at the setup's memory peak) runs only when
-            // they were off.
-            live: if options.clean.drop_repeated_index && options.clean.drop_duplicates {
-                (0..cleaned.triangles.len() as u32).collect()
-            } else {
-                kept_triangles(&cleaned.triangles, n, &mut BuildStats::default())
-            },
+            triangles: mesh.triangles,
+            live,
             original_normals: Vec::new(),
             moved_in: vec![0; n],
             pass: 0,
@@ -262,8 +281,8 @@ impl PassEngine {
         let area_offset = engine.sum_face_planes(options);
         engine.initialise_boundary(options, area_offset);
         for &i in locked {
-            if let Some(l) = engine.locked.get_mut(i as usize) {
-                *l = true;
+            if let Some(&v) = vertex_to.get(i as usize) {
+                engine.locked[v as usize] = true;
             }
         }
         engine.counters.locked_vertices = engine.locked.iter().filter(|&&l| l).count();
@@ -276,7 +295,12 @@ impl PassEngine {
     /// its own input triangle.
     pub fn set_input_surface(&mut self, mut surface: InputSurface, slots: &[u32]) {
         let count = self.triangles.len();
-        surface.seed_hints(0..count, count, slots);
+        let slots: Vec<u32> = self
+            .triangle_from
+            .iter()
+            .map(|&t| slots[t as usize])
+            .collect();
+        surface.seed_hints(0..count, count, &slots);
         self.input_surface = Some(surface);
     }
 
@@ -1060,8 +1084,8 @@ impl PassEngine {
         self.counters.edge_contractions += 1;
         self.counters.max_error = self.counters.max_error.max(error);
         observer.contracted(&Contraction {
-            kept: a,
-            removed: b,
+            kept: self.vertex_from[a as usize],
+            removed: self.vertex_from[b as usize],
             is_virtual: false,
             quadric: q,
             position: placed.position,
@@ -1232,15 +1256,25 @@ impl PassEngine {
     }
 
     /// The live triangles with every vertex in model units (unreferenced vertices
-    /// included; the caller's cleaning drops them).
+    /// included; the caller's cleaning drops them), numbered and ordered as in the
+    /// cleaned mesh.
     pub fn to_mesh(&self) -> IndexedMesh {
+        let mut positions = vec![[0.0; 3]; self.world.len()];
+        for (&from, p) in self.vertex_from.iter().zip(&self.world) {
+            positions[from as usize] = *p;
+        }
+        let mut triangles: Vec<(u32, [u32; 3])> = self
+            .live
+            .iter()
+            .map(|&t| {
+                let corners = self.triangles[t as usize].map(|v| self.vertex_from[v as usize]);
+                (self.triangle_from[t as usize], corners)
+            })
+            .collect();
+        triangles.par_sort_unstable_by_key(|&(from, _)| from);
         IndexedMesh {
-            positions: self.world.clone(),
-            triangles: self
-                .live
-                .iter()
-                .map(|&t| self.triangles[t as usize])
-                .collect(),
+            positions,
+            triangles: triangles.into_iter().map(|(_, t)| t).collect(),
         }
     }
 
