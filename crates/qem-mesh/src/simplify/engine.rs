@@ -11,7 +11,6 @@ use crate::clean::min_double_area;
 use crate::pairs::grid::{virtual_pairs, GridOptions};
 use crate::queue::PairQueue;
 use crate::store::{slot_index, EdgeKey, FaceKey, MeshStore, SlotVec, VertexKey};
-use crate::IndexedMesh;
 use qem_core::{
     endpoint_placement, optimal_placement, solve_first_placement, unit_normal_and_area, DVec3,
     Frame, Placement, PlacementRule, Quadric, WeightedPlane,
@@ -391,20 +390,22 @@ impl Engine {
     }
 
     /// Face quadrics summed into vertex quadrics, border planes or locks, locked
-    /// vertices, virtual pairs, and the first queue. `keys[i]` is the store's key of the
-    /// cleaned mesh's vertex `i`; `locked` lists cleaned-mesh indices.
+    /// vertices, virtual pairs, and the first queue. `keys[i]` is the store's key of
+    /// vertex `i` of the mesh it was built from (the cleaned mesh in locality order),
+    /// `numbers[i]` that vertex's number in the cleaned mesh (for [`Contraction`]
+    /// events); `locked` lists vertex numbers of the mesh the store was built from.
     pub fn initialise(
         &mut self,
-        cleaned: &IndexedMesh,
         keys: &[VertexKey],
+        numbers: &[u32],
         locked: &[u32],
         options: &SimplifyOptions,
     ) {
-        for (i, &v) in keys.iter().enumerate() {
+        for (&v, &index) in keys.iter().zip(numbers) {
             self.state.insert(
                 v,
                 VertexState {
-                    index: i as u32,
+                    index,
                     position: self
                         .frame
                         .to_normalized(DVec3::from_array(self.store.position(v))),
@@ -429,7 +430,7 @@ impl Engine {
             options.pair_threshold.normalized(&self.frame)
         };
         if threshold > 0.0 {
-            self.initialise_virtual_pairs(cleaned, keys, threshold, options);
+            self.initialise_virtual_pairs(keys, threshold, options);
         }
 
         self.queue_every_edge();
@@ -606,18 +607,17 @@ impl Engine {
         }
     }
 
-    /// Virtual pairs from the grid, filtered by [`VirtualPairs`], queued.
+    /// Virtual pairs from the grid, filtered by [`VirtualPairs`], queued; `keys` lists
+    /// every vertex (the grid numbers them by their place in it).
     fn initialise_virtual_pairs(
         &mut self,
-        cleaned: &IndexedMesh,
         keys: &[VertexKey],
         threshold: f64,
         options: &SimplifyOptions,
     ) {
-        let normalized: Vec<[f64; 3]> = cleaned
-            .positions
+        let normalized: Vec<[f64; 3]> = keys
             .iter()
-            .map(|p| self.frame.to_normalized(DVec3::from_array(*p)).to_array())
+            .map(|&v| self.state[v].position.to_array())
             .collect();
         let labels = match options.virtual_pairs {
             VirtualPairs::Any => None,

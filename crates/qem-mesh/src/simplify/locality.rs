@@ -1,28 +1,32 @@
-//! The pass-based order's arrays in space-filling-curve order: the cleaned mesh is
-//! renumbered before the loop so that vertices and triangles near each other in space
-//! are near each other in memory, and numbered back on the way out.
+//! The loops' arrays in space-filling-curve order: the cleaned mesh is renumbered
+//! before either contraction order builds its arrays or store, so that vertices and
+//! triangles near each other in space are near each other in memory, and the output
+//! is numbered back.
 //!
-//! Why: every contraction reads the quadrics, positions, incident lists and
-//! neighbouring triangles of a small patch of the surface, and each pass walks every
-//! vertex's edges; all of those arrays are indexed by vertex and triangle number. In
-//! the input's own order a patch can be spread over the whole of each array, and each
-//! read is then a cache miss. Meshes come in anywhere from well local (marching cubes,
-//! grids) to random (some exporters, merged parts). Measured on the 871k-triangle
-//! dragon with `--fast --quadrics exact --orientation-check` at ratio 0.1 (the report's
-//! `simplify` time, median of 3; the file itself renumbered beforehand, before this
-//! module existed): its own order 2.78 s, this order 2.54 s, a random order 4.20 s.
+//! Why: every contraction reads the quadrics, positions, adjacency and neighbouring
+//! triangles of a small patch of the surface, all indexed by vertex and triangle
+//! number (the greedy loop's store by slot, in the order it was built). In the input's
+//! own order a patch can be spread over the whole of each array, and each read is then
+//! a cache miss. Meshes come in anywhere from well local (marching cubes, grids) to
+//! random (some exporters, merged parts). Measured on the 871k-triangle dragon at
+//! ratio 0.1 (the report's `simplify` time, one to three runs; the file itself
+//! renumbered beforehand, before this module existed): with `--fast --quadrics exact
+//! --orientation-check` its own order 2.78 s, this order 2.54 s, a random order 4.20 s;
+//! with the greedy defaults 6.05 s, 5.73 s and 7.19 s.
 //!
 //! The order: vertices by the Morton code of their normalised position (21 bits per
 //! axis), ties by their cleaned number; triangles by their lowest renumbered corner,
 //! ties in their cleaned order (so of triangles with the same three vertices the first
-//! stays first). Both are total orders on the input alone, so the result does not
-//! depend on the threads. Each triangle keeps its corners in their order.
+//! stays first, and the store keeps the same one). Both are total orders on the input
+//! alone, so the result does not depend on the threads. Each triangle keeps its corners
+//! in their order.
 //!
 //! What callers see: nothing but the tie-breaks. Contractions of equal cost are ordered
-//! by the new numbers, so outputs differ from those of the input's order, but the
-//! output mesh, the observer's [`Contraction`](super::Contraction)s and every index a
-//! caller gives or gets are in the cleaned mesh's numbers, and a run that contracts
-//! nothing gives the cleaned mesh back as it was.
+//! by the new numbers (and the virtual pairs found in this order), so outputs differ
+//! from those of the input's order, but the output mesh, the observer's
+//! [`Contraction`](super::Contraction)s and every index a caller gives or gets are in
+//! the cleaned mesh's numbers and order, and a run that contracts nothing gives the
+//! cleaned mesh back as it was.
 
 use crate::IndexedMesh;
 use qem_core::{DVec3, Frame};
@@ -87,6 +91,44 @@ pub(super) fn in_locality_order(mesh: &IndexedMesh, frame: &Frame) -> Renumbered
         vertex_from,
         vertex_to,
         triangle_from,
+    }
+}
+
+/// `mesh` numbered and ordered as the mesh it came from, where its vertex `i` came
+/// from vertex `vertex_from[i]` and its triangle `k` from triangle `triangle_from[k]`
+/// (no number twice in either): vertices and triangles in the order of those numbers.
+/// What the loops' output goes through, so that it keeps the cleaned mesh's order.
+pub(super) fn in_original_order(
+    mesh: IndexedMesh,
+    vertex_from: &[u32],
+    triangle_from: &[u32],
+) -> IndexedMesh {
+    // A scatter by origin, then the occupied places in order: linear, no sort.
+    let len = vertex_from
+        .iter()
+        .map(|&v| v as usize + 1)
+        .max()
+        .unwrap_or(0);
+    let mut at_origin = vec![u32::MAX; len];
+    for (i, &from) in vertex_from.iter().enumerate() {
+        at_origin[from as usize] = i as u32;
+    }
+    let order: Vec<u32> = at_origin.into_iter().filter(|&i| i != u32::MAX).collect();
+    let mut new_number = vec![0u32; order.len()];
+    for (new, &i) in order.iter().enumerate() {
+        new_number[i as usize] = new as u32;
+    }
+    let positions = order.iter().map(|&i| mesh.positions[i as usize]).collect();
+    let mut triangles: Vec<(u32, [u32; 3])> = mesh
+        .triangles
+        .iter()
+        .zip(triangle_from)
+        .map(|(t, &from)| (from, t.map(|v| new_number[v as usize])))
+        .collect();
+    triangles.par_sort_unstable_by_key(|&(from, _)| from);
+    IndexedMesh {
+        positions,
+        triangles: triangles.into_iter().map(|(_, t)| t).collect(),
     }
 }
 
@@ -219,6 +261,26 @@ mod tests {
             .map(|t| t[0].min(t[1]).min(t[2]))
             .collect();
         assert!(lowest.windows(2).all(|w| w[0] <= w[1]));
+    }
+
+    #[test]
+    fn numbering_back_restores_the_input() {
+        let input = backwards_strip(20);
+        let frame = Frame::from_points(input.positions.iter().map(|p| DVec3::from_array(*p)));
+        let r = in_locality_order(&input, &frame);
+        assert_eq!(
+            in_original_order(r.mesh, &r.vertex_from, &r.triangle_from),
+            input
+        );
+
+        // A subset: vertices 1 and 3 of four, each triangle on its way back.
+        let part = IndexedMesh::new(
+            vec![[3.0; 3], [1.0; 3], [2.0; 3]],
+            vec![[0, 1, 2], [2, 1, 0]],
+        );
+        let back = in_original_order(part, &[3, 1, 2], &[7, 4]);
+        assert_eq!(back.positions, [[1.0; 3], [2.0; 3], [3.0; 3]]);
+        assert_eq!(back.triangles, [[1, 0, 2], [2, 0, 1]]);
     }
 
     #[test]

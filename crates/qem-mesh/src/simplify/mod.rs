@@ -40,9 +40,11 @@ pub use options::{
 pub use report::{Simplified, SimplifyError, SimplifyReport, StopReason, Timings};
 
 use crate::clean::{clean, CleanOptions, Cleaned};
-use crate::store::{slot_index, MeshStore};
+use crate::store::build::kept_triangles;
+use crate::store::{slot_index, BuildStats, FaceKey, MeshStore, SlotVec};
 use crate::IndexedMesh;
 use engine::{Counters, Engine};
+use locality::{in_locality_order, in_original_order, Renumbered};
 use passes::PassEngine;
 use qem_core::{DVec3, Frame};
 use std::time::Instant;
@@ -159,13 +161,11 @@ pub fn simplify_levels(
 
     let frame = Frame::from_points(cleaned.mesh.positions.iter().map(|p| DVec3::from_array(*p)));
     let mut run = match options.order {
-        ContractionOrder::Greedy => Run::Greedy(set_up_greedy(
-            &cleaned,
-            frame,
-            &locked,
-            options,
-            &mut timings,
-        )?),
+        ContractionOrder::Greedy => {
+            let (engine, face_from) =
+                set_up_greedy(&cleaned, frame, &locked, options, &mut timings)?;
+            Run::Greedy(engine, face_from)
+        }
         ContractionOrder::Passes => {
             refuse_what_passes_lack(options, &frame)?;
             let clock = Instant::now();
@@ -257,33 +257,63 @@ pub fn simplify_levels(
 }
 
 /// The greedy loop's store, quadrics, queue and (on the other core meanwhile) the
-/// orientation check's index.
+/// orientation check's index, built from the cleaned mesh in locality order (see
+/// [`locality`]); and the cleaned number of each of the store's faces.
 fn set_up_greedy(
     cleaned: &Cleaned,
     frame: Frame,
     locked: &[u32],
     options: &SimplifyOptions,
     timings: &mut Timings,
-) -> Result<Engine, SimplifyError> {
+) -> Result<(Engine, SlotVec<FaceKey, u32>), SimplifyError> {
     let clock = Instant::now();
-    let (store, keys) = MeshStore::from_mesh(&cleaned.mesh)?;
+    let Renumbered {
+        mesh,
+        vertex_from,
+        vertex_to,
+        triangle_from,
+    } = in_locality_order(&cleaned.mesh, &frame);
+    let (store, keys) = MeshStore::from_mesh(&mesh)?;
     timings.build = clock.elapsed();
+    let locked: Vec<u32> = locked
+        .iter()
+        .filter_map(|&i| vertex_to.get(i as usize).copied())
+        .collect();
+    drop(vertex_to);
+
+    // The store's faces are the triangles it kept, in order (it never adds one).
+    let kept: Vec<u32> = if store.face_count() == mesh.triangles.len() {
+        (0..mesh.triangles.len() as u32).collect()
+    } else {
+        kept_triangles(
+            &mesh.triangles,
+            mesh.positions.len(),
+            &mut BuildStats::default(),
+        )
+    };
+    let mut face_from = SlotVec::for_keys(store.faces(), u32::MAX);
+    for (f, &t) in store.faces().zip(&kept) {
+        face_from.set(f, triangle_from[t as usize]);
+    }
+    // The store holds its own copy: gone before the setup's peak.
+    drop((mesh, kept));
 
     let mut engine = Engine::new(store, frame, options);
     let clock = Instant::now();
     // The orientation check's index is independent of the quadrics and queue: built on
     // the other core meanwhile (deterministic either way).
     let ((), input_surface) = rayon::join(
-        || engine.initialise(&cleaned.mesh, &keys, locked, options),
+        || engine.initialise(&keys, &vertex_from, &locked, options),
         || {
             options
                 .orientation_check
                 .then(|| orientation::InputSurface::new(&cleaned.mesh, &frame))
         },
     );
-    // The store makes one face per cleaned triangle, in order, when none is refused;
-    // each face's search hint starts as its own triangle.
+    // The store makes one face per triangle, in order, when none is refused; each
+    // face's search hint starts as its own input triangle.
     engine.input_surface = input_surface.map(|(mut surface, slots)| {
+        let slots: Vec<u32> = triangle_from.iter().map(|&t| slots[t as usize]).collect();
         surface.seed_hints(
             engine.store.faces().map(slot_index),
             engine.store.face_count(),
@@ -292,7 +322,7 @@ fn set_up_greedy(
         surface
     });
     timings.setup = clock.elapsed();
-    Ok(engine)
+    Ok((engine, face_from))
 }
 
 /// [`SimplifyError::NotInPasses`] for the first option set that the pass-based order
@@ -315,7 +345,8 @@ fn refuse_what_passes_lack(options: &SimplifyOptions, frame: &Frame) -> Result<(
 // One value per run, made once: the size of the larger variant costs nothing.
 #[allow(clippy::large_enum_variant)]
 enum Run {
-    Greedy(Engine),
+    /// The greedy loop, and the cleaned number of each of its store's faces.
+    Greedy(Engine, SlotVec<FaceKey, u32>),
     Passes(PassEngine),
 }
 
@@ -327,14 +358,21 @@ impl Run {
         observer: &mut dyn Observer,
     ) -> Result<StopReason, SimplifyError> {
         match self {
-            Run::Greedy(engine) => engine.run(target, options, observer),
+            Run::Greedy(engine, _) => engine.run(target, options, observer),
             Run::Passes(engine) => Ok(engine.run(target, observer)),
         }
     }
 
     fn to_mesh(&self) -> IndexedMesh {
         match self {
-            Run::Greedy(engine) => engine.store.to_mesh(),
+            Run::Greedy(engine, face_from) => {
+                let (mesh, keys) = engine.store.to_mesh_with_map();
+                // Every live vertex has a state (its cleaned number).
+                let vertex_from: Vec<u32> = keys.iter().map(|&v| engine.state[v].index).collect();
+                let triangle_from: Vec<u32> =
+                    engine.store.faces().map(|f| *face_from.get(f)).collect();
+                in_original_order(mesh, &vertex_from, &triangle_from)
+            }
             Run::Passes(engine) => engine.to_mesh(),
         }
     }
@@ -343,7 +381,7 @@ impl Run {
     /// `Engine::is_zero_area`).
     fn is_zero_area(&self, world_corners: [[f64; 3]; 3]) -> bool {
         match self {
-            Run::Greedy(engine) => engine.is_zero_area(world_corners),
+            Run::Greedy(engine, _) => engine.is_zero_area(world_corners),
             Run::Passes(engine) => {
                 checks::is_zero_area(&engine.frame, &engine.settings, world_corners)
             }
@@ -352,14 +390,14 @@ impl Run {
 
     fn counters(&self) -> Counters {
         match self {
-            Run::Greedy(engine) => engine.counters,
+            Run::Greedy(engine, _) => engine.counters,
             Run::Passes(engine) => engine.counters,
         }
     }
 
     fn flipped_faces(&self) -> usize {
         match self {
-            Run::Greedy(engine) => engine.flipped_faces(),
+            Run::Greedy(engine, _) => engine.flipped_faces(),
             Run::Passes(engine) => engine.flipped_faces(),
         }
     }

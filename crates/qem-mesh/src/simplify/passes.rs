@@ -50,7 +50,7 @@
 
 use super::checks::{moved_face_verdict, Rejection};
 use super::engine::{place_merged, Counters, Settings};
-use super::locality::{in_locality_order, Renumbered};
+use super::locality::{in_locality_order, in_original_order, Renumbered};
 use super::observer::{Contraction, Observer, Progress};
 use super::options::QuadricMode;
 use super::options::{BoundaryMode, SimplifyOptions};
@@ -1259,23 +1259,20 @@ impl PassEngine {
     /// included; the caller's cleaning drops them), numbered and ordered as in the
     /// cleaned mesh.
     pub fn to_mesh(&self) -> IndexedMesh {
-        let mut positions = vec![[0.0; 3]; self.world.len()];
-        for (&from, p) in self.vertex_from.iter().zip(&self.world) {
-            positions[from as usize] = *p;
-        }
-        let mut triangles: Vec<(u32, [u32; 3])> = self
+        let mesh = IndexedMesh {
+            positions: self.world.clone(),
+            triangles: self
+                .live
+                .iter()
+                .map(|&t| self.triangles[t as usize])
+                .collect(),
+        };
+        let triangle_from: Vec<u32> = self
             .live
             .iter()
-            .map(|&t| {
-                let corners = self.triangles[t as usize].map(|v| self.vertex_from[v as usize]);
-                (self.triangle_from[t as usize], corners)
-            })
+            .map(|&t| self.triangle_from[t as usize])
             .collect();
-        triangles.par_sort_unstable_by_key(|&(from, _)| from);
-        IndexedMesh {
-            positions,
-            triangles: triangles.into_iter().map(|(_, t)| t).collect(),
-        }
+        in_original_order(mesh, &self.vertex_from, &triangle_from)
     }
 
     /// Live triangles whose normal points more than 90° away from the input triangle's.
