@@ -3,6 +3,7 @@
 mod common;
 
 use common::{assert_valid, concat, grid, uv_sphere};
+use qem_mesh::clean::CleanOptions;
 use qem_mesh::simplify::{
     simplify, simplify_levels, Length, NoObserver, SimplifyError, SimplifyOptions, StopReason,
     Target,
@@ -281,4 +282,38 @@ fn levels_continue_one_run_and_nest_in_count() {
     assert!(out[2].report.max_error >= out[1].report.max_error);
     let single = simplify(&sphere, &options(levels[0])).unwrap();
     assert_eq!(single.mesh, out[0].mesh);
+}
+
+// Both loops work on the cleaned mesh renumbered in locality order and number their
+// output back. With the duplicate-face pass off, they keep only the first of two faces
+// on the same three vertices, so their faces no longer match the triangles one to one:
+// a run that contracts nothing must still give back every other face, in its order,
+// with the input's vertex numbers.
+#[test]
+fn a_no_op_with_a_skipped_duplicate_face_keeps_the_input_order() {
+    let sphere = uv_sphere([0.0; 3], 1.0, 6, 8);
+    // Numbered backwards, so that the locality order differs from the input's.
+    let last = sphere.vertex_count() as u32 - 1;
+    let positions: Vec<[f64; 3]> = sphere.positions.iter().rev().copied().collect();
+    let mut triangles: Vec<[u32; 3]> = sphere
+        .triangles
+        .iter()
+        .rev()
+        .map(|t| t.map(|v| last - v))
+        .collect();
+    let skipped = triangles.len() / 2;
+    let [a, b, c] = triangles[3];
+    triangles.insert(skipped, [b, c, a]);
+    let input = IndexedMesh::new(positions, triangles);
+    let mut expected = input.clone();
+    expected.triangles.remove(skipped);
+
+    for order in [SimplifyOptions::DEFAULT, SimplifyOptions::FAST] {
+        let options = order
+            .with_target(Target::Triangles(input.triangle_count() + 10))
+            .with_clean(CleanOptions::DEFAULT.with_drop_duplicates(false));
+        let out = simplify(&input, &options).unwrap();
+        assert_eq!(out.report.edge_contractions, 0);
+        assert_eq!(out.mesh, expected, "{:?}", options.order);
+    }
 }

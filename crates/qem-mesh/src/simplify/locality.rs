@@ -94,22 +94,20 @@ pub(super) fn in_locality_order(mesh: &IndexedMesh, frame: &Frame) -> Renumbered
     }
 }
 
-/// `mesh` numbered and ordered as the mesh it came from, where its vertex `i` came
-/// from vertex `vertex_from[i]` and its triangle `k` from triangle `triangle_from[k]`
-/// (no number twice in either): vertices and triangles in the order of those numbers.
-/// What the loops' output goes through, so that it keeps the cleaned mesh's order.
+/// `mesh` numbered and ordered as the mesh it came from, which had `vertex_count`
+/// vertices, where its vertex `i` came from vertex `vertex_from[i]` (below
+/// `vertex_count`) and its triangle `k` from triangle `triangle_from[k]` (no number
+/// twice in either): vertices and triangles in the order of those numbers. What the
+/// loops' output goes through, so that it keeps the cleaned mesh's order.
 pub(super) fn in_original_order(
     mesh: IndexedMesh,
+    vertex_count: usize,
     vertex_from: &[u32],
     triangle_from: &[u32],
 ) -> IndexedMesh {
-    // A scatter by origin, then the occupied places in order: linear, no sort.
-    let len = vertex_from
-        .iter()
-        .map(|&v| v as usize + 1)
-        .max()
-        .unwrap_or(0);
-    let mut at_origin = vec![u32::MAX; len];
+    // A scatter by origin, then the occupied places in order: linear, no sort. (Sized
+    // by the count, not by the largest number: no number can make it grow.)
+    let mut at_origin = vec![u32::MAX; vertex_count];
     for (i, &from) in vertex_from.iter().enumerate() {
         at_origin[from as usize] = i as u32;
     }
@@ -269,16 +267,21 @@ mod tests {
         let frame = Frame::from_points(input.positions.iter().map(|p| DVec3::from_array(*p)));
         let r = in_locality_order(&input, &frame);
         assert_eq!(
-            in_original_order(r.mesh, &r.vertex_from, &r.triangle_from),
+            in_original_order(
+                r.mesh,
+                input.positions.len(),
+                &r.vertex_from,
+                &r.triangle_from
+            ),
             input
         );
 
-        // A subset: vertices 1 and 3 of four, each triangle on its way back.
+        // A subset: vertices 1, 2 and 3 of four, and two triangles of eight.
         let part = IndexedMesh::new(
             vec![[3.0; 3], [1.0; 3], [2.0; 3]],
             vec![[0, 1, 2], [2, 1, 0]],
         );
-        let back = in_original_order(part, &[3, 1, 2], &[7, 4]);
+        let back = in_original_order(part, 4, &[3, 1, 2], &[7, 4]);
         assert_eq!(back.positions, [[1.0; 3], [2.0; 3], [3.0; 3]]);
         assert_eq!(back.triangles, [[1, 0, 2], [2, 0, 1]]);
     }

@@ -162,9 +162,8 @@ pub fn simplify_levels(
     let frame = Frame::from_points(cleaned.mesh.positions.iter().map(|p| DVec3::from_array(*p)));
     let mut run = match options.order {
         ContractionOrder::Greedy => {
-            let (engine, face_from) =
-                set_up_greedy(&cleaned, frame, &locked, options, &mut timings)?;
-            Run::Greedy(engine, face_from)
+            let (engine, numbers) = set_up_greedy(&cleaned, frame, &locked, options, &mut timings)?;
+            Run::Greedy(engine, numbers)
         }
         ContractionOrder::Passes => {
             refuse_what_passes_lack(options, &frame)?;
@@ -265,7 +264,7 @@ fn set_up_greedy(
     locked: &[u32],
     options: &SimplifyOptions,
     timings: &mut Timings,
-) -> Result<(Engine, SlotVec<FaceKey, u32>), SimplifyError> {
+) -> Result<(Engine, CleanedNumbers), SimplifyError> {
     let clock = Instant::now();
     let Renumbered {
         mesh,
@@ -310,10 +309,13 @@ fn set_up_greedy(
                 .then(|| orientation::InputSurface::new(&cleaned.mesh, &frame))
         },
     );
-    // The store makes one face per triangle, in order, when none is refused; each
-    // face's search hint starts as its own input triangle.
+    // Each face's search hint starts as its own input triangle.
     engine.input_surface = input_surface.map(|(mut surface, slots)| {
-        let slots: Vec<u32> = triangle_from.iter().map(|&t| slots[t as usize]).collect();
+        let slots: Vec<u32> = engine
+            .store
+            .faces()
+            .map(|f| slots[*face_from.get(f) as usize])
+            .collect();
         surface.seed_hints(
             engine.store.faces().map(slot_index),
             engine.store.face_count(),
@@ -322,7 +324,20 @@ fn set_up_greedy(
         surface
     });
     timings.setup = clock.elapsed();
-    Ok((engine, face_from))
+    let numbers = CleanedNumbers {
+        vertex_count: cleaned.mesh.positions.len(),
+        face_from,
+    };
+    Ok((engine, numbers))
+}
+
+/// What the greedy loop's output needs to be numbered back into the cleaned mesh's
+/// numbers and order (its vertices carry their own, see `VertexState::index`).
+struct CleanedNumbers {
+    /// The cleaned mesh's vertex count.
+    vertex_count: usize,
+    /// The cleaned triangle each store face was made from.
+    face_from: SlotVec<FaceKey, u32>,
 }
 
 /// [`SimplifyError::NotInPasses`] for the first option set that the pass-based order
@@ -345,8 +360,8 @@ fn refuse_what_passes_lack(options: &SimplifyOptions, frame: &Frame) -> Result<(
 // One value per run, made once: the size of the larger variant costs nothing.
 #[allow(clippy::large_enum_variant)]
 enum Run {
-    /// The greedy loop, and the cleaned number of each of its store's faces.
-    Greedy(Engine, SlotVec<FaceKey, u32>),
+    /// The greedy loop, and how to number its output back.
+    Greedy(Engine, CleanedNumbers),
     Passes(PassEngine),
 }
 
@@ -365,13 +380,16 @@ impl Run {
 
     fn to_mesh(&self) -> IndexedMesh {
         match self {
-            Run::Greedy(engine, face_from) => {
+            Run::Greedy(engine, numbers) => {
                 let (mesh, keys) = engine.store.to_mesh_with_map();
                 // Every live vertex has a state (its cleaned number).
                 let vertex_from: Vec<u32> = keys.iter().map(|&v| engine.state[v].index).collect();
-                let triangle_from: Vec<u32> =
-                    engine.store.faces().map(|f| *face_from.get(f)).collect();
-                in_original_order(mesh, &vertex_from, &triangle_from)
+                let triangle_from: Vec<u32> = engine
+                    .store
+                    .faces()
+                    .map(|f| *numbers.face_from.get(f))
+                    .collect();
+                in_original_order(mesh, numbers.vertex_count, &vertex_from, &triangle_from)
             }
             Run::Passes(engine) => engine.to_mesh(),
         }

@@ -100,10 +100,10 @@ impl InputSurface {
     }
 
     /// Gives each face its own input triangle as its first hint: `faces` lists the
-    /// numbers of the run's `face_count` faces (see `hints`) in the order of the
-    /// cleaned mesh's triangles they were made from, `slots` is what
-    /// [`new`](Self::new) returned. When the two do not correspond one to one (the
-    /// store refused some triangle), no face gets a hint yet.
+    /// numbers of the run's `face_count` faces (see `hints`), and `slots` the index
+    /// slot of each one's input triangle, in the same order (the loops take those
+    /// from what [`new`](Self::new) returned, through their own numbering). When the
+    /// two lists differ in length, no face gets a hint yet.
     ///
     /// Why seed the hints: without one, a face's first test is a full nearest search
     /// (on the dragon at ratio 0.1, about 9 in 10 of the full searches). Any triangle

@@ -1272,7 +1272,12 @@ impl PassEngine {
             .iter()
             .map(|&t| self.triangle_from[t as usize])
             .collect();
-        in_original_order(mesh, &self.vertex_from, &triangle_from)
+        in_original_order(
+            mesh,
+            self.vertex_from.len(),
+            &self.vertex_from,
+            &triangle_from,
+        )
     }
 
     /// Live triangles whose normal points more than 90° away from the input triangle's.
