@@ -8,7 +8,7 @@
 //! instructions, and a node costs about 54 bytes per child instead of 56 for a binary
 //! node plus 48 for its normal box.
 //!
-//! Long thin triangles are indexed in pieces (see [`pieces`](super::pieces)): a
+//! Long thin triangles are indexed in pieces (see [`pieces`]): a
 //! leaf entry is then a piece, which names its triangle, and a triangle may be met
 //! more than once in a walk. Meshes without such triangles have no pieces, and their
 //! tree is the one a leaf entry per triangle gives.
@@ -543,6 +543,16 @@ impl TriangleBvh {
     }
 }
 
+/// What [`build`] returns: the nodes, the corners in leaf order, where each triangle
+/// went, the root's box, and the pieces' triangles (when there are pieces).
+type Built = (
+    Vec<WideNode>,
+    Vec<[P3; 3]>,
+    Vec<u32>,
+    Aabb,
+    Option<Vec<u32>>,
+);
+
 /// The tree over the `count` triangles whose corners `corners_of` gives (those
 /// corners returned in leaf order, see [`TriangleBvh::corners`]), node 0 the root,
 /// every node after its parent; where each triangle went (`slots[i]` is the
@@ -557,16 +567,6 @@ impl TriangleBvh {
 /// half, where the half is a leaf). Built straight into wide nodes, so the build never
 /// holds a binary node per range (56 bytes each, about 134 MB on the 4M sphere).
 ///
-/// What [`build`] returns: the nodes, the corners in leaf order, where each triangle
-/// went, the root's box, and the pieces' triangles (when there are pieces).
-type Built = (
-    Vec<WideNode>,
-    Vec<[P3; 3]>,
-    Vec<u32>,
-    Aabb,
-    Option<Vec<u32>>,
-);
-
 /// Four steps, so that none reads corners out of order: [`partition`] puts every
 /// entry in its leaf (on both cores), the corners are gathered in leaf order (on both
 /// cores), [`wide_nodes`] lays out the nodes (which needs only the range sizes), and

@@ -539,7 +539,7 @@ impl Engine {
     }
 
     /// The mean area of the store's faces in normalised units (degenerate faces count
-    /// as 0), for [`Weighting::Mixed`]; 0 when there are none.
+    /// as 0), for [`Weighting::Mixed`](super::Weighting::Mixed); 0 when there are none.
     fn mean_face_area(&self) -> f64 {
         let count = self.store.face_count();
         if count == 0 {
