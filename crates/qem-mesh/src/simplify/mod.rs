@@ -311,15 +311,11 @@ fn set_up_greedy(
     );
     // Each face's search hint starts as its own input triangle.
     engine.input_surface = input_surface.map(|(mut surface, slots)| {
-        let slots: Vec<u32> = engine
-            .store
-            .faces()
-            .map(|f| slots[*face_from.get(f) as usize])
-            .collect();
         surface.seed_hints(
-            engine.store.faces().map(slot_index),
-            engine.store.face_count(),
-            &slots,
+            engine
+                .store
+                .faces()
+                .map(|f| (slot_index(f), slots[*face_from.get(f) as usize])),
         );
         surface
     });

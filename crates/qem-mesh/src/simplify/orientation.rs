@@ -99,30 +99,21 @@ impl InputSurface {
         (surface, slots)
     }
 
-    /// Gives each face its own input triangle as its first hint: `faces` lists the
-    /// numbers of the run's `face_count` faces (see `hints`), and `slots` the index
-    /// slot of each one's input triangle, in the same order (the loops take those
-    /// from what [`new`](Self::new) returned, through their own numbering). When the
-    /// two lists differ in length, no face gets a hint yet.
+    /// Gives each face its own input triangle as its first hint: `hints` pairs each
+    /// face's number (see `hints`) with the index slot of its input triangle (the
+    /// loops take those from what [`new`](Self::new) returned, through their own
+    /// numbering).
     ///
     /// Why seed the hints: without one, a face's first test is a full nearest search
     /// (on the dragon at ratio 0.1, about 9 in 10 of the full searches). Any triangle
     /// would do for correctness (a hint only bounds the nearest distance from above);
     /// the face's own input triangle is the nearest one.
-    pub fn seed_hints(
-        &mut self,
-        faces: impl Iterator<Item = usize> + Clone,
-        face_count: usize,
-        slots: &[u32],
-    ) {
-        if face_count != slots.len() {
-            return;
-        }
+    pub fn seed_hints(&mut self, hints: impl Iterator<Item = (usize, u32)> + Clone) {
         // Sized from the numbers rather than grown (growing by doubling would hold up
         // to twice the memory).
-        let len = faces.clone().map(|f| f + 1).max().unwrap_or(0);
+        let len = hints.clone().map(|(f, _)| f + 1).max().unwrap_or(0);
         self.hints = vec![NO_HINT; len];
-        for (face, &slot) in faces.zip(slots) {
+        for (face, slot) in hints {
             self.hints[face] = slot;
         }
     }

@@ -294,13 +294,9 @@ impl PassEngine {
     /// (`slots` as [`InputSurface::new`] returned them): each triangle's first hint is
     /// its own input triangle.
     pub fn set_input_surface(&mut self, mut surface: InputSurface, slots: &[u32]) {
-        let count = self.triangles.len();
-        let slots: Vec<u32> = self
-            .triangle_from
-            .iter()
-            .map(|&t| slots[t as usize])
-            .collect();
-        surface.seed_hints(0..count, count, &slots);
+        let hints = (self.triangle_from.iter().enumerate())
+            .map(|(t, &cleaned_t)| (t, slots[cleaned_t as usize]));
+        surface.seed_hints(hints);
         self.input_surface = Some(surface);
     }
 
