@@ -97,6 +97,10 @@ impl Observer for BarObserver<'_> {
     fn should_stop(&mut self) -> bool {
         interrupted()
     }
+
+    fn wants_contractions(&self) -> bool {
+        false
+    }
 }
 
 /// Polls Ctrl-C only (for batch workers, whose progress is counted per file).
@@ -105,5 +109,9 @@ pub struct CtrlCObserver;
 impl Observer for CtrlCObserver {
     fn should_stop(&mut self) -> bool {
         interrupted()
+    }
+
+    fn wants_contractions(&self) -> bool {
+        false
     }
 }

@@ -260,6 +260,25 @@ pub(super) struct Counters {
 }
 
 impl Counters {
+    /// Adds `other`'s counts to these and keeps the larger of the two largest errors
+    /// (the counts of one block of a pass, see `pass_blocks`).
+    pub(super) fn absorb(&mut self, other: &Counters) {
+        self.edge_contractions += other.edge_contractions;
+        self.virtual_contractions += other.virtual_contractions;
+        self.virtual_pairs += other.virtual_pairs;
+        self.virtual_pairs_capped += other.virtual_pairs_capped;
+        self.max_error = self.max_error.max(other.max_error);
+        self.rejected_degenerate += other.rejected_degenerate;
+        self.rejected_flip += other.rejected_flip;
+        self.rejected_sliver += other.rejected_sliver;
+        self.rejected_topology += other.rejected_topology;
+        self.rejected_locked += other.rejected_locked;
+        self.rejected_border += other.rejected_border;
+        self.rejected_merge += other.rejected_merge;
+        self.rejected_orientation += other.rejected_orientation;
+        self.locked_vertices += other.locked_vertices;
+    }
+
     pub(super) fn reject(&mut self, why: Rejection) {
         let counter = match why {
             Rejection::Degenerate => &mut self.rejected_degenerate,

@@ -26,6 +26,7 @@ mod locality;
 mod observer;
 mod options;
 mod orientation;
+mod pass_blocks;
 mod pass_exact;
 mod passes;
 mod report;

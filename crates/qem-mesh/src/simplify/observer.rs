@@ -65,10 +65,21 @@ pub trait Observer {
     /// Called after every contraction. Meant for tests and analysis tools: it is on the
     /// hot path, so keep it cheap.
     fn contracted(&mut self, _contraction: &Contraction) {}
+    /// Whether [`contracted`](Self::contracted) does anything. An observer that
+    /// returns `false` spares the pass-based order from keeping the contractions it
+    /// makes on other threads until they can be reported in order. The default is
+    /// `true`, so that an observer that watches them gets every one.
+    fn wants_contractions(&self) -> bool {
+        true
+    }
 }
 
 /// The observer that does nothing.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct NoObserver;
 
-impl Observer for NoObserver {}
+impl Observer for NoObserver {
+    fn wants_contractions(&self) -> bool {
+        false
+    }
+}

@@ -15,7 +15,11 @@
 //!    first when the round may reach the target), each checked like the greedy loop's
 //!    pairs (fold-over, merged faces, border loops, locks); then the attempted edges
 //!    and every edge at a moved vertex leave the batch, and the next round starts,
-//!    until the batch is empty or the target is reached. With the orientation check
+//!    until the batch is empty or the target is reached. Without locks, exact
+//!    quadrics and the orientation check, and far from the target, the pairs of a
+//!    round whose neighbourhoods lie inside one block of vertex numbers are attempted
+//!    first, the blocks on the thread pool, and the rest after them in order
+//!    ([`super::pass_blocks`]). With the orientation check
 //!    on, a chunk of a round's pairs may first be *speculated* on the thread pool
 //!    (their placements and the check's quick tests, against the arrays as they are;
 //!    when most recent attempts contracted), and the attempts take what still holds
@@ -48,17 +52,20 @@
 //! few triangles there, and so only refuse more); every other vertex has the
 //! triangles it had at the pass's start, minus the removed ones.
 
-use super::checks::{moved_face_verdict, Rejection};
+use super::checks::Rejection;
 use super::engine::{place_merged, Counters, Settings};
 use super::locality::{in_locality_order, in_original_order, Renumbered};
 use super::observer::{Contraction, Observer, Progress};
 use super::options::QuadricMode;
 use super::options::{BoundaryMode, SimplifyOptions};
 use super::orientation::{InputSurface, Quick};
+use super::pass_blocks::{
+    contract_block, plain_checks, Around, BlockOutcome, Candidate, Corners, Fixed, Slab,
+    BLOCK_VERTICES, REMOVED,
+};
 use super::pass_exact::{shorter_list, PassExact};
 use super::report::StopReason;
 use super::waivers::{penalised, Waivers};
-use crate::clean::cross_underflows;
 use crate::store::build::kept_triangles;
 use crate::store::BuildStats;
 use crate::IndexedMesh;
@@ -76,17 +83,6 @@ const SPECULATION_MIN_LEN: usize = 16;
 
 /// How often (in attempted contractions) the observer's progress is called.
 const OBSERVER_INTERVAL: usize = 4096;
-
-/// Marks a removed triangle in [`PassEngine::triangles`].
-const REMOVED: u32 = u32::MAX;
-
-/// An edge of the current pass and its cost (normalised units).
-#[derive(Clone, Copy, Debug)]
-struct Candidate {
-    a: u32,
-    b: u32,
-    cost: f64,
-}
 
 /// The order candidates are taken in: cost, then [`scatter`] of the index in the
 /// pass's list. A total order (NaN costs are stored as +∞, see
@@ -113,13 +109,6 @@ fn by_cost((x, i): (f64, u32), (y, j): (f64, u32)) -> Ordering {
 fn scatter(i: u32) -> u32 {
     let x = i.wrapping_mul(0x9E37_79B1);
     x ^ (x >> 16)
-}
-
-/// A live triangle around a vertex: its index and its current corners.
-#[derive(Clone, Copy, Debug)]
-struct Around {
-    triangle: u32,
-    corners: [u32; 3],
 }
 
 /// Whether the pass ended for a reason that ends the run.
@@ -195,6 +184,10 @@ pub(super) struct PassEngine {
     /// how many asked again because a corner had moved since (for tests).
     verdicts_reused: usize,
     verdicts_asked_again: usize,
+    /// How many pairs the blocks of [`super::pass_blocks`] contracted, and how many
+    /// they left to the sequential attempts (for tests).
+    block_contractions: usize,
+    block_deferrals: usize,
     since_report: usize,
     /// The input surface for the orientation check; `None` when the check is off.
     input_surface: Option<InputSurface>,
@@ -203,6 +196,12 @@ pub(super) struct PassEngine {
     waivers: Waivers,
     /// The planes of exact quadrics; `None` with summed quadrics.
     exact: Option<PassExact>,
+    /// Vertices per block of [`super::pass_blocks`], and where each block's triangles
+    /// start (the last entry is the triangle count).
+    block_vertices: u32,
+    block_triangles: Vec<u32>,
+    /// Scratch: the pairs of a round the blocks left to the sequential attempts.
+    deferred: Vec<u32>,
 }
 
 impl PassEngine {
@@ -270,12 +269,18 @@ impl PassEngine {
             chunk_contracted: 0,
             verdicts_reused: 0,
             verdicts_asked_again: 0,
+            block_contractions: 0,
+            block_deferrals: 0,
             since_report: 0,
             input_surface: None,
             waivers: Waivers::new(n),
             exact: (options.quadrics == QuadricMode::Exact).then(|| PassExact::new(n)),
             position,
+            block_vertices: BLOCK_VERTICES,
+            block_triangles: Vec::new(),
+            deferred: Vec::new(),
         };
+        engine.set_block_vertices(BLOCK_VERTICES);
         // The incident lists first: the quadrics are summed along them.
         engine.list_incident_triangles();
         let area_offset = engine.sum_face_planes(options);
@@ -298,6 +303,133 @@ impl PassEngine {
             .map(|(t, &cleaned_t)| (t, slots[cleaned_t as usize]));
         surface.seed_hints(hints);
         self.input_surface = Some(surface);
+    }
+
+    /// What no contraction of the pass changes, for the shared pieces of an attempt
+    /// ([`super::pass_blocks`]).
+    fn fixed(&self) -> Fixed<'_> {
+        Fixed {
+            frame: &self.frame,
+            settings: &self.settings,
+            first: &self.first,
+            incident: &self.incident,
+            original_normals: &self.original_normals,
+            vertex_from: &self.vertex_from,
+            pass: self.pass,
+        }
+    }
+
+    /// Every vertex's positions, for the fold-over check.
+    fn corners_view(&self) -> Corners<'_> {
+        Corners {
+            first_vertex: 0,
+            position: &self.position,
+            world: &self.world,
+        }
+    }
+
+    /// The whole mesh as one [`Slab`] (for the sequential attempts), and what does not
+    /// change.
+    fn split(&mut self) -> (Slab<'_>, Fixed<'_>) {
+        let slab = Slab {
+            first_vertex: 0,
+            first_triangle: 0,
+            position: &mut self.position,
+            world: &mut self.world,
+            quadric: &mut self.quadric,
+            moved_in: &mut self.moved_in,
+            triangles: &mut self.triangles,
+        };
+        let fixed = Fixed {
+            frame: &self.frame,
+            settings: &self.settings,
+            first: &self.first,
+            incident: &self.incident,
+            original_normals: &self.original_normals,
+            vertex_from: &self.vertex_from,
+            pass: self.pass,
+        };
+        (slab, fixed)
+    }
+
+    /// Sets the vertices per block of [`super::pass_blocks`] (tests use small blocks
+    /// on small meshes). Only before the run: the triangles' numbers are by lowest
+    /// corner then, which is what makes each block's triangles one run.
+    pub(super) fn set_block_vertices(&mut self, block_vertices: u32) {
+        debug_assert_eq!(self.pass, 0);
+        self.block_vertices = block_vertices.max(1);
+        let blocks = (self.position.len() as u32).div_ceil(self.block_vertices);
+        let triangles = &self.triangles;
+        self.block_triangles = (0..=blocks)
+            .map(|k| {
+                let start = k.saturating_mul(self.block_vertices);
+                triangles.partition_point(|t| t.iter().min().is_some_and(|&c| c < start)) as u32
+            })
+            .collect();
+    }
+
+    /// Whether rounds are contracted block by block ([`super::pass_blocks`]): only
+    /// without the state the blocks do not split (locks, exact quadrics' planes, the
+    /// orientation check's hints and waivers), and only with more than one block.
+    fn uses_blocks(&self) -> bool {
+        self.exact.is_none()
+            && self.input_surface.is_none()
+            && !self.settings.any_locked
+            && self.position.len() > self.block_vertices as usize
+    }
+
+    /// Contracts the pairs of `selected` (a round, in list order) that are interior to
+    /// their block, the blocks on the thread pool, and leaves the others in
+    /// `deferred`, in order. The contractions reach the observer and the counters in
+    /// block order, as if the blocks had run one after another.
+    fn contract_blocks(
+        &mut self,
+        selected: &[u32],
+        deferred: &mut Vec<u32>,
+        observer: &mut dyn Observer,
+    ) -> BlockOutcome {
+        let candidates = std::mem::take(&mut self.candidates);
+        let block_vertices = self.block_vertices;
+        let watch = observer.wants_contractions();
+        let block_triangles = std::mem::take(&mut self.block_triangles);
+        let (slab, fixed) = self.split();
+        let mut slabs: Vec<Option<Slab>> = slab
+            .into_blocks(block_vertices, &block_triangles)
+            .into_iter()
+            .map(Some)
+            .collect();
+        // The list is in order of the smaller end, so each block's pairs are one run.
+        let jobs: Vec<(Slab, &[u32])> = selected
+            .chunk_by(|&x, &y| {
+                candidates[x as usize].a / block_vertices
+                    == candidates[y as usize].a / block_vertices
+            })
+            .filter_map(|pairs| {
+                let block = candidates[pairs[0] as usize].a / block_vertices;
+                Some((slabs[block as usize].take()?, pairs))
+            })
+            .collect();
+        let outcomes: Vec<BlockOutcome> = jobs
+            .into_par_iter()
+            .map(|(mut slab, pairs)| contract_block(&mut slab, &fixed, &candidates, pairs, watch))
+            .collect();
+        drop(slabs);
+        self.block_triangles = block_triangles;
+        self.candidates = candidates;
+        deferred.clear();
+        let mut total = BlockOutcome::default();
+        for outcome in outcomes {
+            deferred.extend_from_slice(&outcome.deferred);
+            for contraction in &outcome.contractions {
+                observer.contracted(contraction);
+            }
+            self.counters.absorb(&outcome.counters);
+            total.contracted += outcome.contracted;
+            total.removed += outcome.removed;
+            total.attempted += outcome.attempted;
+            total.over_bound |= outcome.over_bound;
+        }
+        total
     }
 
     /// The corners of triangle `t` in the normalised frame.
@@ -551,6 +683,7 @@ impl PassEngine {
         let mut selected = std::mem::take(&mut self.selected);
         let mut speculations = Vec::new();
         let mut batch = std::mem::take(&mut self.batch);
+        let mut deferred = std::mem::take(&mut self.deferred);
         self.list_batch(take, &mut batch);
         self.tried.clear();
         self.tried.resize(edges, false);
@@ -575,7 +708,8 @@ impl PassEngine {
                 continue;
             }
             self.select_local_minima(&batch, &mut selected);
-            if selected.len() * 2 >= live_count - target {
+            let may_reach_target = selected.len() * 2 >= live_count - target;
+            if may_reach_target {
                 // The round may reach the target: the cheapest first, so that the
                 // ones left out are the costliest, not the last in vertex order.
                 let candidates = &self.candidates;
@@ -583,19 +717,35 @@ impl PassEngine {
                     cheaper((&candidates[x as usize], x), (&candidates[y as usize], y))
                 });
             }
-            for (k, &i) in selected.iter().enumerate() {
+            // Far from the target, the pairs interior to their block go first, on the
+            // thread pool; the others follow in order (see `pass_blocks`). Each
+            // interior contraction removes at most two triangles, so the target
+            // cannot be passed among them.
+            let attempts = if !may_reach_target && self.uses_blocks() {
+                let blocks = self.contract_blocks(&selected, &mut deferred, observer);
+                live_count -= blocks.removed;
+                contracted += blocks.contracted;
+                self.block_contractions += blocks.contracted;
+                self.block_deferrals += deferred.len();
+                over_bound |= blocks.over_bound;
+                self.since_report += blocks.attempted;
+                &deferred
+            } else {
+                &selected
+            };
+            for (k, &i) in attempts.iter().enumerate() {
                 if live_count <= target {
                     break 'rounds;
                 }
                 if k % SPECULATION_CHUNK == 0 {
                     speculations.clear();
                     if self.speculating() {
-                        let end = selected.len().min(k + SPECULATION_CHUNK);
+                        let end = attempts.len().min(k + SPECULATION_CHUNK);
                         // Not past the edges the target can still take (two triangles
                         // each), with room for refusals.
                         let wanted = (live_count - target).div_ceil(2) + SPECULATION_CHUNK / 8;
                         let end = end.min(k + wanted);
-                        self.speculate(&selected[k..end], &mut speculations);
+                        self.speculate(&attempts[k..end], &mut speculations);
                     }
                     (self.chunk_attempted, self.chunk_contracted) = (0, 0);
                 }
@@ -645,6 +795,7 @@ impl PassEngine {
         }
         self.batch = batch;
         self.selected = selected;
+        self.deferred = deferred;
         self.drop_removed();
         match end {
             Some(end) => end,
@@ -1044,20 +1195,8 @@ impl PassEngine {
         // The contraction itself.
         self.waivers.forget(a);
         self.waivers.forget(b);
-        self.moved_in[a as usize] = self.pass;
-        self.moved_in[b as usize] = self.pass;
         self.moved_in_chunk[a as usize] = self.chunk;
         self.moved_in_chunk[b as usize] = self.chunk;
-        self.position[a as usize] = self.frame.to_normalized(world);
-        self.world[a as usize] = world.to_array();
-        self.quadric[a as usize] = q;
-        let mut removed = 0;
-        for x in &around[0] {
-            if x.corners.contains(&b) {
-                self.triangles[x.triangle as usize][0] = REMOVED;
-                removed += 1;
-            }
-        }
         if let Some(exact) = &mut self.exact {
             // Each collapsed triangle's plane joins `a` and its third corner now.
             let collapsed = around[0].iter().filter(|x| x.corners.contains(&b));
@@ -1070,13 +1209,8 @@ impl PassEngine {
                 }),
             );
         }
-        // `b`'s other triangles are `a`'s now: renamed at once, so that every triangle
-        // read later in the pass has its current corners.
-        for x in &around[1] {
-            if !x.corners.contains(&a) {
-                self.triangles[x.triangle as usize] = x.corners.map(|c| if c == b { a } else { c });
-            }
-        }
+        let (mut slab, fixed) = self.split();
+        let removed = slab.contract(&fixed, [a, b], world, q, around);
         self.counters.edge_contractions += 1;
         self.counters.max_error = self.counters.max_error.max(error);
         observer.contracted(&Contraction {
@@ -1101,56 +1235,16 @@ impl PassEngine {
         shared: usize,
         around: &[Vec<Around>; 2],
     ) -> Result<(), Rejection> {
-        self.fold_over(a, b, world, around)?;
-        if would_merge_faces(a, b, around) {
-            return Err(Rejection::Merge);
-        }
-        if self.settings.keep_border_loops && !keeps_border_loops(a, b, shared, around) {
-            return Err(Rejection::Border);
-        }
+        plain_checks(
+            &self.corners_view(),
+            &self.fixed(),
+            [a, b],
+            world,
+            shared,
+            around,
+        )?;
         if self.settings.any_locked && self.locked_vertex_would_vanish(a, b, around) {
             return Err(Rejection::Locked);
-        }
-        Ok(())
-    }
-
-    /// The greedy loop's fold-over check (see `Engine::fold_over`) on `around`.
-    fn fold_over(
-        &self,
-        a: u32,
-        b: u32,
-        world: DVec3,
-        around: &[Vec<Around>; 2],
-    ) -> Result<(), Rejection> {
-        let moved = self.frame.to_normalized(world);
-        for x in around.iter().flatten() {
-            let corners = x.corners;
-            if corners.contains(&a) && corners.contains(&b) {
-                continue; // collapses with the pair
-            }
-            let old = self.corners(corners);
-            let new = std::array::from_fn::<_, 3, _>(|i| {
-                if corners[i] == a || corners[i] == b {
-                    moved
-                } else {
-                    old[i]
-                }
-            });
-            moved_face_verdict(
-                &self.settings,
-                old,
-                new,
-                || self.original_normals[x.triangle as usize],
-                || {
-                    cross_underflows(corners.map(|c| {
-                        if c == a || c == b {
-                            world.to_array()
-                        } else {
-                            self.world[c as usize]
-                        }
-                    }))
-                },
-            )?;
         }
         Ok(())
     }
@@ -1323,36 +1417,6 @@ struct FaceAgrees {
     settled: Option<u32>,
 }
 
-/// The neighbours of `v` joined to it by a border edge (exactly one triangle of
-/// `around`, the triangles of `v`, holds both), in increasing order. Live triangles
-/// have distinct corners, so that is a neighbour listed once among the corners.
-///
-/// Found by sorting the corners other than `v`: for a usual star (up to
-/// [`SMALL_STAR`] triangles), a dozen numbers on the stack, about half the
-/// instructions of the search of the other triangles per corner that this replaced;
-/// for a vertex with thousands of triangles (a fan), k log k steps, not k².
-fn border_neighbours(v: u32, around: &[Around]) -> SmallVec<[u32; 8]> {
-    if around.len() > SMALL_STAR {
-        let mut ends: Vec<u32> = around
-            .iter()
-            .flat_map(|x| x.corners)
-            .filter(|&c| c != v)
-            .collect();
-        return listed_once(&mut ends);
-    }
-    let mut ends = [0u32; 3 * SMALL_STAR];
-    let mut n = 0;
-    for x in around {
-        for c in x.corners {
-            if c != v {
-                ends[n] = c;
-                n += 1;
-            }
-        }
-    }
-    listed_once(&mut ends[..n])
-}
-
 /// The positions of a triangle's `corners` once the pair `ends` is contracted to
 /// `moved` (normalised units): either end goes to `moved`, the others stay.
 fn moved_corners(
@@ -1370,59 +1434,10 @@ fn moved_corners(
     })
 }
 
-/// The numbers that occur exactly once in `ends` (sorted in place), in increasing
-/// order.
-fn listed_once(ends: &mut [u32]) -> SmallVec<[u32; 8]> {
-    ends.sort_unstable();
-    let mut single = SmallVec::new();
-    for run in ends.chunk_by(|p, q| p == q) {
-        if let [only] = run {
-            single.push(*only);
-        }
-    }
-    single
-}
-
-/// The star size up to which [`border_neighbours`] sorts on the stack.
-const SMALL_STAR: usize = 16;
-
-/// Whether contracting the edge `a b` would merge a triangle `a x y` with a triangle
-/// `b x y` (see `Engine::would_merge_faces`).
-fn would_merge_faces(a: u32, b: u32, around: &[Vec<Around>; 2]) -> bool {
-    around[1].iter().any(|y| {
-        if y.corners.contains(&a) {
-            return false; // collapses with the pair
-        }
-        let mut others = y.corners.into_iter().filter(|&c| c != b);
-        match (others.next(), others.next()) {
-            (Some(p), Some(q)) => around[0]
-                .iter()
-                .any(|x| x.corners.contains(&p) && x.corners.contains(&q)),
-            _ => false,
-        }
-    })
-}
-
-/// Whether contracting the edge `a b` (held by `shared` triangles) keeps every border
-/// loop (see `Engine::keeps_border_loops`): when both ends are on a border, `a b` must
-/// be a border edge, and no third vertex may be joined to both by border edges.
-fn keeps_border_loops(a: u32, b: u32, shared: usize, around: &[Vec<Around>; 2]) -> bool {
-    let a_border = border_neighbours(a, &around[0]);
-    if a_border.is_empty() {
-        return true;
-    }
-    let b_border = border_neighbours(b, &around[1]);
-    if b_border.is_empty() {
-        return true;
-    }
-    if shared != 1 {
-        return false;
-    }
-    !a_border
-        .iter()
-        .any(|&x| x != b && b_border.binary_search(&x).is_ok())
-}
-
 #[cfg(test)]
 #[path = "passes_speculation_tests.rs"]
 mod speculation_tests;
+
+#[cfg(test)]
+#[path = "passes_blocks_tests.rs"]
+mod blocks_tests;

@@ -69,15 +69,15 @@ fn speculation_gives_the_sequential_output() {
 /// What a run gives that must not depend on speculation: per level, the stop
 /// reason, the output's bits, the counters (max error by its bits) and the flipped
 /// faces.
-type Levels = Vec<(StopReason, Vec<[u64; 3]>, Vec<[u32; 3]>, String, usize)>;
+pub(super) type Levels = Vec<(StopReason, Vec<[u64; 3]>, Vec<[u32; 3]>, String, usize)>;
 
 /// Runs the pass-based order on `mesh` to each of `targets` in turn, speculating or
 /// not, on `threads` threads; the levels and what the run did.
-fn run_levels(
+pub(super) fn run_levels(
     mesh: &IndexedMesh,
     options: &SimplifyOptions,
     targets: &[usize],
-    speculation: bool,
+    setup: Setup,
     threads: usize,
 ) -> (Levels, Seen) {
     let pool = rayon::ThreadPoolBuilder::new()
@@ -103,7 +103,10 @@ fn run_levels(
             let (surface, slots) = InputSurface::new(&cleaned.mesh, &frame);
             engine.set_input_surface(surface, &slots);
         }
-        engine.speculate_chunks = speculation;
+        engine.speculate_chunks = setup.speculation;
+        if let Some(block_vertices) = setup.block_vertices {
+            engine.set_block_vertices(block_vertices);
+        }
         let mut levels = Vec::new();
         for &target in targets {
             let reason = engine.run(target, &mut NoObserver);
@@ -126,28 +129,49 @@ fn run_levels(
             reused: engine.verdicts_reused,
             asked_again: engine.verdicts_asked_again,
             refused: engine.counters.rejected_orientation,
+            block_contractions: engine.block_contractions,
+            block_deferrals: engine.block_deferrals,
         };
         (levels, seen)
     })
 }
 
+/// How a test run sets the engine up: whether it speculates, and the vertices per
+/// block of `pass_blocks` (`None`: the engine's own).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Setup {
+    pub speculation: bool,
+    pub block_vertices: Option<u32>,
+}
+
 /// What a run did: orientation verdicts taken from a speculation and asked again,
-/// and pairs the orientation check refused.
+/// pairs the orientation check refused, and pairs contracted by the blocks of
+/// `pass_blocks` or left by them to the sequential attempts.
 #[derive(Clone, Copy, Debug, Default)]
-struct Seen {
-    reused: usize,
-    asked_again: usize,
-    refused: usize,
+pub(super) struct Seen {
+    pub reused: usize,
+    pub asked_again: usize,
+    pub refused: usize,
+    pub block_contractions: usize,
+    pub block_deferrals: usize,
 }
 
 /// Asserts that speculating gives the sequential levels, on one, two and four
 /// threads; returns what the two-thread speculated run did.
 fn assert_same(mesh: &IndexedMesh, options: &SimplifyOptions, targets: &[usize]) -> Seen {
-    let (sequential, plain) = run_levels(mesh, options, targets, false, 2);
+    let plain_setup = Setup {
+        speculation: false,
+        block_vertices: None,
+    };
+    let (sequential, plain) = run_levels(mesh, options, targets, plain_setup, 2);
     assert_eq!(plain.reused + plain.asked_again, 0);
     let mut on_two = plain;
     for threads in [1, 2, 4] {
-        let (speculated, seen) = run_levels(mesh, options, targets, true, threads);
+        let setup = Setup {
+            speculation: true,
+            ..plain_setup
+        };
+        let (speculated, seen) = run_levels(mesh, options, targets, setup, threads);
         if threads == 2 {
             on_two = seen;
         }
@@ -164,7 +188,7 @@ fn assert_same(mesh: &IndexedMesh, options: &SimplifyOptions, targets: &[usize])
 }
 
 /// A deterministic value in [0, 1) from `i` (a hash, not a stream).
-fn noise(i: u64) -> f64 {
+pub(super) fn noise(i: u64) -> f64 {
     let mut x = i.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0xD1B5_4A32_D192_ED03;
     x ^= x >> 31;
     x = x.wrapping_mul(0xBF58_476D_1CE4_E5B9);
@@ -173,7 +197,7 @@ fn noise(i: u64) -> f64 {
 }
 
 /// An `nx` × `ny` grid in x y with heights `z(x, y)`, its vertices from `first`.
-fn grid(
+pub(super) fn grid(
     nx: u32,
     ny: u32,
     first: u32,
@@ -196,7 +220,7 @@ fn grid(
 
 /// A sheet folded like an accordion (folds far steeper than wide, so faces near a
 /// fold lie close to faces of the next pleat facing the other way), with noise.
-fn accordion(nx: u32, ny: u32, pleats: u32) -> IndexedMesh {
+pub(super) fn accordion(nx: u32, ny: u32, pleats: u32) -> IndexedMesh {
     let (p, t) = grid(nx, ny, 0, |x, y| {
         let u = f64::from(x) / f64::from(nx);
         let phase = (u * f64::from(pleats)).fract();
@@ -237,7 +261,7 @@ fn two_sided_sheet(n: u32, gap: f64) -> IndexedMesh {
 /// `pages` sheets (`n` × `n` each) sharing their first row, the spine, so every
 /// spine edge has `pages` triangles; pages at close angles, every third one wound
 /// the other way.
-fn book(pages: u32, n: u32) -> IndexedMesh {
+pub(super) fn book(pages: u32, n: u32) -> IndexedMesh {
     let spine: Vec<[f64; 3]> = (0..=n)
         .map(|x| [f64::from(x) / f64::from(n), 0.0, 0.0])
         .collect();
@@ -283,7 +307,7 @@ fn book(pages: u32, n: u32) -> IndexedMesh {
 
 /// A bumpy grid whose every triangle has its own three vertices (an unwelded
 /// export): with exact welding off, coincident vertices stay apart.
-fn unwelded(n: u32) -> IndexedMesh {
+pub(super) fn unwelded(n: u32) -> IndexedMesh {
     let (p, t) = grid(n, n, 0, |x, y| {
         let k = u64::from(y * (n + 1) + x);
         [f64::from(x), f64::from(y), (4.0 * noise(k)).floor() * 0.25]
@@ -318,7 +342,7 @@ fn checked(options: SimplifyOptions) -> SimplifyOptions {
 }
 
 /// Targets at several ratios of `mesh`'s triangles, largest first.
-fn ratios(mesh: &IndexedMesh, ratios: &[f64]) -> Vec<usize> {
+pub(super) fn ratios(mesh: &IndexedMesh, ratios: &[f64]) -> Vec<usize> {
     ratios
         .iter()
         .map(|r| (r * mesh.triangle_count() as f64) as usize)
@@ -432,7 +456,7 @@ fn speculation_is_sequential_on_tiny_meshes() {
 /// Up to `max_vertices` vertices on a 5×5×5 integer grid, scaled to the extremes
 /// of `f64` or not, and up to 300 faces with any indices: coincident vertices,
 /// zero-area, duplicate and non-manifold faces.
-fn soup(max_vertices: usize) -> impl Strategy<Value = IndexedMesh> {
+pub(super) fn soup(max_vertices: usize) -> impl Strategy<Value = IndexedMesh> {
     (3..max_vertices).prop_flat_map(|n| {
         let positions = prop::collection::vec(prop::array::uniform3(0..5i32), n);
         let triangles = prop::collection::vec(prop::array::uniform3(0..n as u32), 1..300);
@@ -491,7 +515,7 @@ fn soup_options() -> impl Strategy<Value = SimplifyOptions> {
 /// with random coarse heights times `amplitude` (steep creases and spikes when
 /// large), each triangle dropped with a chance of `drop` and wound the other way
 /// with a chance of `flip`.
-fn rough_grid() -> impl Strategy<Value = IndexedMesh> {
+pub(super) fn rough_grid() -> impl Strategy<Value = IndexedMesh> {
     (20..60u32, 20..60u32, 0.01..4.0f64, 0.0..0.3f64, 0.0..0.3f64).prop_flat_map(
         |(nx, ny, amplitude, drop, flip)| {
             let vertices = ((nx + 1) * (ny + 1)) as usize;
