@@ -230,6 +230,29 @@ fn bumpy_grid_with_borders_matches_brute_force_to_the_end_in_passes() {
     );
 }
 
+/// 151 × 121 = 18,271 vertices: more than one block of `simplify/pass_blocks.rs`
+/// (16,384 vertex numbers), so most pairs of each round are contracted block by block,
+/// with their changes to the planes made after the blocks; every contraction must still
+/// match the brute-force union, with the orientation check on as well.
+#[test]
+fn a_grid_of_several_blocks_matches_brute_force_in_passes() {
+    let mesh = grid(150, 120, 0.4);
+    for check in [false, true] {
+        let options = exact_passes(0.1).with_orientation_check(check);
+        let brute = run(&mesh, &options);
+        assert!(
+            brute.failures.is_empty(),
+            "{:#?}",
+            &brute.failures[..5.min(brute.failures.len())]
+        );
+        assert!(
+            brute.contractions > 14_000,
+            "{} contractions",
+            brute.contractions
+        );
+    }
+}
+
 #[test]
 fn the_sum_mode_double_counts_in_passes_too() {
     let mesh = grid(6, 6, 0.4);

@@ -7,10 +7,9 @@
 //! quadrics listed beside the edges, with the orientation check, the speculated
 //! chunks of each round (placements and quick tests, a parallel map collected in
 //! order; `simplify/passes_speculation_tests.rs` compares them with no speculation at
-//! all on 1, 2 and 4 threads), and without it and exact quadrics, the rounds'
-//! contractions block by block (the grid's 53,361 vertices are four blocks of
-//! `simplify/pass_blocks.rs`; `simplify/passes_blocks_tests.rs` cuts small meshes
-//! into small blocks). The input
+//! all on 1, 2 and 4 threads), and the rounds' contractions block by block (the
+//! grid's 53,361 vertices are four blocks of `simplify/pass_blocks.rs`;
+//! `simplify/passes_blocks_tests.rs` cuts small meshes into small blocks). The input
 //! has 157,410 edges, so in the first passes each thread of a larger pool costs tens of
 //! thousands of them: the split is real, not a formality of a tiny input.
 

@@ -118,6 +118,11 @@ impl InputSurface {
         }
     }
 
+    /// How many faces have a slot in the hints (every face once seeded).
+    pub fn hint_count(&self) -> usize {
+        self.hints.len()
+    }
+
     /// The hint of `face`, if it has one.
     #[inline]
     fn hint(&self, face: usize) -> Option<u32> {
@@ -140,36 +145,11 @@ impl InputSurface {
         corners: [DVec3; 3],
         neighbour_hint: &mut Option<u32>,
     ) -> bool {
-        let (centroid, normal) = centroid_and_normal(corners);
-        let known2 = match self.quick_verdict(face, centroid, normal, neighbour_hint) {
-            Quick::Agrees { settled } => {
-                if let Some(t) = settled {
-                    self.set_hint(face, t);
-                }
-                return true;
-            }
-            Quick::Undecided { known2 } => known2,
-        };
-        let nearest = self.bvh.nearest_triangles_within(
-            centroid.to_array(),
-            known2.unwrap_or(f64::INFINITY),
-            NEAR_FACTOR,
-            NEAR_MARGIN,
-            NEAR_COUNT,
-            &mut self.near,
-        );
-        if let Some(t) = nearest {
-            self.set_hint(face, t);
-            *neighbour_hint = Some(t);
+        if self.hints.len() <= face {
+            self.hints.resize(face + 1, NO_HINT);
         }
-        // A zero-area input triangle (cleaning drops exact ones) has no say.
-        // (Normals computed here rather than kept: 24 bytes per input triangle saved,
-        // and this full test is rare once every face has a hint.)
-        self.near.iter().all(|&i| {
-            let [a, b, c] = self.bvh.corners(i).map(DVec3::from_array);
-            let n = (b - a).cross(c - a);
-            n.dot(normal) > 0.0 || n == DVec3::ZERO
-        })
+        let InputSurface { bvh, near, hints } = self;
+        Nearest { bvh }.agrees(&mut hints[face], near, corners, neighbour_hint)
     }
 
     /// The quick tests of [`agrees`](Self::agrees) alone, without touching the hints
@@ -185,21 +165,89 @@ impl InputSurface {
         neighbour_hint: &mut Option<u32>,
     ) -> Quick {
         let (centroid, normal) = centroid_and_normal(corners);
-        self.quick_verdict(face, centroid, normal, neighbour_hint)
+        let nearest = Nearest { bvh: &self.bvh };
+        nearest.quick_verdict(self.hint(face), centroid, normal, neighbour_hint)
     }
 
-    /// The quick tests of [`agrees`](Self::agrees): with the face's hint, then with
+    /// The index, for asking [`Nearest::agrees`] with hints held elsewhere, and the
+    /// hints, one per face (for the blocks of `pass_blocks`, each with its faces'
+    /// share of the hints).
+    pub fn parts(&mut self) -> (Nearest<'_>, &mut [u32]) {
+        (Nearest { bvh: &self.bvh }, &mut self.hints)
+    }
+
+    /// Makes `t` the hint of `face`.
+    pub fn set_hint(&mut self, face: usize, t: u32) {
+        if self.hints.len() <= face {
+            self.hints.resize(face + 1, NO_HINT);
+        }
+        self.hints[face] = t;
+    }
+}
+
+/// The input surface's index, asked with a face's hint held by the caller (one slot of
+/// [`InputSurface`]'s hints, or of a block's share of them).
+#[derive(Clone, Copy)]
+pub(super) struct Nearest<'a> {
+    bvh: &'a TriangleBvh,
+}
+
+impl Nearest<'_> {
+    /// [`InputSurface::agrees`] for a face whose hint is `hint` ([`NO_HINT`] when it
+    /// has none; updated as there), with `near` as scratch.
+    #[inline]
+    pub fn agrees(
+        &self,
+        hint: &mut u32,
+        near: &mut Vec<u32>,
+        corners: [DVec3; 3],
+        neighbour_hint: &mut Option<u32>,
+    ) -> bool {
+        let (centroid, normal) = centroid_and_normal(corners);
+        let own_hint = (*hint != NO_HINT).then_some(*hint);
+        let known2 = match self.quick_verdict(own_hint, centroid, normal, neighbour_hint) {
+            Quick::Agrees { settled } => {
+                if let Some(t) = settled {
+                    *hint = t;
+                }
+                return true;
+            }
+            Quick::Undecided { known2 } => known2,
+        };
+        let nearest = self.bvh.nearest_triangles_within(
+            centroid.to_array(),
+            known2.unwrap_or(f64::INFINITY),
+            NEAR_FACTOR,
+            NEAR_MARGIN,
+            NEAR_COUNT,
+            near,
+        );
+        if let Some(t) = nearest {
+            *hint = t;
+            *neighbour_hint = Some(t);
+        }
+        // A zero-area input triangle (cleaning drops exact ones) has no say.
+        // (Normals computed here rather than kept: 24 bytes per input triangle saved,
+        // and this full test is rare once every face has a hint.)
+        near.iter().all(|&i| {
+            let [a, b, c] = self.bvh.corners(i).map(DVec3::from_array);
+            let n = (b - a).cross(c - a);
+            n.dot(normal) > 0.0 || n == DVec3::ZERO
+        })
+    }
+
+    /// The quick tests of [`agrees`](Self::agrees): with the face's own hint, then with
     /// the neighbour's when it is nearer.
     #[inline]
     fn quick_verdict(
         &self,
-        face: usize,
+        own_hint: Option<u32>,
         centroid: DVec3,
         normal: DVec3,
         neighbour_hint: &mut Option<u32>,
     ) -> Quick {
         let previous = *neighbour_hint;
-        let hint = self.hint(face).or(previous);
+        let hint = own_hint.or(previous);
         *neighbour_hint = hint;
         let mut known2 = hint.and_then(|h| self.bvh.distance_squared_to(centroid.to_array(), h));
         if self.quick_test(centroid, normal, known2) {
@@ -239,13 +287,5 @@ impl InputSurface {
             && !self
                 .bvh
                 .any_facing_away(centroid.to_array(), radius, normal.to_array())
-    }
-
-    /// Makes `t` the hint of `face`.
-    pub fn set_hint(&mut self, face: usize, t: u32) {
-        if self.hints.len() <= face {
-            self.hints.resize(face + 1, NO_HINT);
-        }
-        self.hints[face] = t;
     }
 }

@@ -7,9 +7,17 @@
 //! round is *interior* to its block when every live triangle around either end lies
 //! in the block's run of triangles and has all three corners in the block's run of
 //! vertices. What a contraction of an interior pair reads and writes (the triangles
-//! around its ends, their corners' positions, its ends' quadrics) then belongs to that
-//! block alone, so the interior pairs of different blocks can be contracted at the same
-//! time: each block gets its own slices of the arrays ([`Slab`]).
+//! around its ends, their corners' positions, its ends' quadrics, the orientation
+//! check's hints of those triangles) then belongs to that block alone, so the interior
+//! pairs of different blocks can be contracted at the same time: each block gets its
+//! own slices of the arrays ([`Slab`]). What the blocks share they only read during
+//! the round: the pass's lists, the input surface's index, exact quadrics' planes as of
+//! the pass's start (a pass reads only those; see [`super::pass_exact`]) and the
+//! waivers as of the round's start (see [`WaiverChange`] for why that is enough); their
+//! changes to the last two are made after the blocks, in block order.
+//!
+//! Not with locked vertices: the lock check looks at a locked neighbour's triangles,
+//! which may lie outside the block.
 //!
 //! The order is fixed by the numbers, not by the threads: in a round, the interior
 //! pairs of each block are attempted in the round's order, blocks one after another as
@@ -17,13 +25,18 @@
 //! that were not interior, in the round's order, by the sequential attempts. The
 //! output is therefore the same with any number of threads.
 //!
-//! Measured before this existed, on the dragon at ratio 0.1 with `--fast`: the rounds'
-//! sequential attempts were about 600 ms of the 960 ms contraction phase, and with
-//! blocks of 16,384 vertices, 87–93% of the pairs of a pass's first round were interior.
+//! Measured before this existed, on the dragon at ratio 0.1: with `--fast`, the rounds'
+//! sequential attempts were about 600 ms of the 960 ms contraction phase; with every
+//! default quality option, the attempts (0.88 s) and their speculation on both cores
+//! (0.87 s) were most of 2.6 s. With blocks of 16,384 vertices, 87–93% of the pairs of
+//! a pass's first round were interior. (BENCHMARKS.md, "Rounds block by block".)
 
 use super::checks::{moved_face_verdict, Rejection};
 use super::engine::{place_merged, Counters, Settings};
 use super::observer::Contraction;
+use super::orientation::Nearest;
+use super::pass_exact::{shorter_list, PassExact};
+use super::waivers::Waivers;
 use crate::clean::cross_underflows;
 use qem_core::{DVec3, Frame, Quadric};
 use smallvec::SmallVec;
@@ -63,6 +76,15 @@ pub(super) struct Fixed<'a> {
     /// Each engine vertex's number in the cleaned mesh (for the observer).
     pub vertex_from: &'a [u32],
     pub pass: u32,
+    /// Exact quadrics' planes as of the pass's start (`None`: summed quadrics). A
+    /// contraction's changes to them wait in [`BlockOutcome::exact_changes`].
+    pub exact: Option<&'a PassExact>,
+    /// The orientation check's index (`None`: the check is off); the hints are the
+    /// slab's.
+    pub nearest: Option<Nearest<'a>>,
+    /// The waivers as of the round's start; changes wait in
+    /// [`BlockOutcome::waiver_changes`].
+    pub waivers: &'a Waivers,
 }
 
 /// The positions of a run of vertices, read-only: what the fold-over check reads.
@@ -138,6 +160,9 @@ pub(super) struct Slab<'a> {
     pub moved_in: &'a mut [u32],
     /// Corners of each triangle; [`REMOVED`] in the first once it is gone.
     pub triangles: &'a mut [[u32; 3]],
+    /// The orientation check's hint of each triangle (empty when the check is off, or
+    /// for the sequential attempts, which use the engine's).
+    pub hints: &'a mut [u32],
 }
 
 impl<'a> Slab<'a> {
@@ -224,10 +249,40 @@ impl<'a> Slab<'a> {
         removed
     }
 
+    /// The orientation check (see `PassEngine::faces_agree_with_input`) of moving `a`
+    /// and `b` to `moved` (normalised units), with the slab's hints; `near` is
+    /// scratch.
+    fn faces_agree(
+        &mut self,
+        nearest: Nearest,
+        near: &mut Vec<u32>,
+        [a, b]: [u32; 2],
+        moved: DVec3,
+        around: &[Vec<Around>; 2],
+    ) -> bool {
+        // A triangle seen for the first time borrows the hint of the one checked before.
+        let mut neighbour_hint = None;
+        around.iter().flatten().all(|x| {
+            let corners = x.corners;
+            if corners.contains(&a) && corners.contains(&b) {
+                return true;
+            }
+            let new = corners.map(|c| {
+                if c == a || c == b {
+                    moved
+                } else {
+                    self.position[(c - self.first_vertex) as usize]
+                }
+            });
+            let slot = (x.triangle - self.first_triangle) as usize;
+            nearest.agrees(&mut self.hints[slot], near, new, &mut neighbour_hint)
+        })
+    }
+
     /// The slab cut into blocks of `block_vertices` vertices, the `k`-th block with
     /// the triangles from `triangle_starts[k]` to `triangle_starts[k + 1]` (one entry
     /// per block and one more; relative to the whole mesh, so only for a slab of all of
-    /// it).
+    /// it). The hints, when there are any, are one per triangle and split likewise.
     pub fn into_blocks(self, block_vertices: u32, triangle_starts: &[u32]) -> Vec<Slab<'a>> {
         debug_assert_eq!((self.first_vertex, self.first_triangle), (0, 0));
         let Slab {
@@ -236,6 +291,7 @@ impl<'a> Slab<'a> {
             mut quadric,
             mut moved_in,
             mut triangles,
+            mut hints,
             ..
         } = self;
         let mut blocks = Vec::with_capacity(triangle_starts.len().saturating_sub(1));
@@ -254,6 +310,9 @@ impl<'a> Slab<'a> {
             let (this_triangles, rest) =
                 std::mem::take(&mut triangles).split_at_mut(triangle_count);
             triangles = rest;
+            let hint_count = if hints.is_empty() { 0 } else { triangle_count };
+            let (this_hints, rest) = std::mem::take(&mut hints).split_at_mut(hint_count);
+            hints = rest;
             blocks.push(Slab {
                 first_vertex,
                 first_triangle: bounds[0],
@@ -262,6 +321,7 @@ impl<'a> Slab<'a> {
                 quadric: this_quadric,
                 moved_in: this_moved_in,
                 triangles: this_triangles,
+                hints: this_hints,
             });
         }
         blocks
@@ -292,17 +352,52 @@ pub(super) struct BlockOutcome {
     pub attempted: usize,
     /// Whether a pair was left for its error being above the bound.
     pub over_bound: bool,
+    /// Pairs the orientation check refused (each waived: see [`super::waivers`]).
+    pub waived: usize,
+    /// The changes to the waivers, in order, for the caller to make.
+    pub waiver_changes: Vec<WaiverChange>,
+    /// Each contraction's changes to exact quadrics' planes, in order.
+    pub exact_changes: Vec<ExactChange>,
+}
+
+/// A contraction's change to exact quadrics' planes, for the caller to make with
+/// `PassExact::contract`: `removed` merged into `kept`, and each collapsed triangle
+/// with its third corner (at most two: a block defers pairs that more triangles hold).
+#[derive(Clone, Debug)]
+pub(super) struct ExactChange {
+    pub kept: u32,
+    pub removed: u32,
+    pub collapsed: SmallVec<[(u32, u32); 2]>,
+}
+
+/// A change to the waivers that a block's worker leaves for the caller.
+///
+/// Why they can wait: a pair's waiver is read only at its own attempt, a round's pairs
+/// share no vertex, and each change touches only the waivers of its own pair's ends
+/// (and drops those ends from their partners' lists), so no attempt of the same round
+/// reads what another's changes; and the changes of different pairs commute.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum WaiverChange {
+    /// The waived pair was contracted without the check (`Waivers::take`).
+    Take(u32, u32),
+    /// The pair was refused by the check (`Waivers::waive`).
+    Waive(u32, u32),
+    /// The vertex moved or was removed (`Waivers::forget`).
+    Forget(u32),
 }
 
 /// Attempts `pairs` (indices into `candidates`, in the round's order) on `slab`, one
 /// block; a pair that is not interior to it is deferred.
 ///
-/// The attempt is the sequential one for a configuration without locks, exact
-/// quadrics and the orientation check (the only ones that use blocks): placement, the
-/// error bound, fold-over, merged faces, border loops, then the contraction. A pair
-/// more than two triangles hold (a non-manifold edge) is deferred, so that the
-/// round's interior contractions remove at most two triangles each and cannot pass the
-/// target (the caller uses blocks only when twice the round's size is short of it).
+/// The attempt is the sequential one (`PassEngine::check_and_contract`) for a run
+/// without locks (the only one that uses blocks): the merged quadric (less the shared
+/// planes with exact quadrics), placement, the error bound, fold-over, merged faces,
+/// border loops, the orientation check unless the pair is waived, then the
+/// contraction. The changes to what the blocks share (waivers, exact quadrics' planes)
+/// wait in the outcome. A pair more than two triangles hold (a non-manifold edge) is
+/// deferred, so that the round's interior contractions remove at most two triangles
+/// each and cannot pass the target (the caller uses blocks only when twice the
+/// round's size is short of it).
 pub(super) fn contract_block(
     slab: &mut Slab,
     fixed: &Fixed,
@@ -312,6 +407,7 @@ pub(super) fn contract_block(
 ) -> BlockOutcome {
     let mut out = BlockOutcome::default();
     let mut around = [Vec::new(), Vec::new()];
+    let mut near = Vec::new();
     for &i in pairs {
         let Candidate { a, b, .. } = candidates[i as usize];
         if !slab.gather(fixed, a, &mut around[0]) || !slab.gather(fixed, b, &mut around[1]) {
@@ -325,7 +421,11 @@ pub(super) fn contract_block(
         }
         out.attempted += 1;
         let (sa, sb) = (slab.slot_of(a), slab.slot_of(b));
-        let q = slab.quadric[sa] + slab.quadric[sb];
+        let mut q = slab.quadric[sa] + slab.quadric[sb];
+        if let Some(exact) = fixed.exact {
+            let triangles = (slab.first_triangle, &*slab.triangles);
+            q -= shared_planes(fixed.first, fixed.incident, triangles, exact, [a, b]);
+        }
         let ends = [(slab.position[sa], false), (slab.position[sb], false)];
         let placed = place_merged(&q, ends, fixed.settings.placement);
         let error = q.rms_distance(placed.cost);
@@ -344,6 +444,40 @@ pub(super) fn contract_block(
         if let Err(why) = plain_checks(&slab.corners(), fixed, [a, b], world, shared, &around) {
             out.counters.reject(why);
             continue;
+        }
+        // Last, as in the sequential attempts; a waived pair is taken without it.
+        let waived = fixed.waivers.contains(a, b);
+        if waived {
+            out.waiver_changes.push(WaiverChange::Take(a, b));
+        } else if let Some(nearest) = fixed.nearest {
+            let moved = fixed.frame.to_normalized(world);
+            if !slab.faces_agree(nearest, &mut near, [a, b], moved, &around) {
+                out.counters.reject(Rejection::Orientation);
+                out.waiver_changes.push(WaiverChange::Waive(a, b));
+                out.waived += 1;
+                continue;
+            }
+        }
+        for v in [a, b] {
+            if fixed.waivers.involves(v) {
+                out.waiver_changes.push(WaiverChange::Forget(v));
+            }
+        }
+        if fixed.exact.is_some() {
+            // Each collapsed triangle's plane joins `a` and its third corner now.
+            let collapsed = around[0]
+                .iter()
+                .filter(|x| x.corners.contains(&b))
+                .filter_map(|x| {
+                    let third = x.corners.into_iter().find(|&c| c != a && c != b)?;
+                    Some((x.triangle, third))
+                })
+                .collect();
+            out.exact_changes.push(ExactChange {
+                kept: a,
+                removed: b,
+                collapsed,
+            });
         }
         out.removed += slab.contract(fixed, [a, b], world, q, &around);
         out.contracted += 1;
@@ -465,4 +599,33 @@ fn keeps_border_loops(a: u32, b: u32, shared: usize, around: &[Vec<Around>; 2]) 
     !a_border
         .iter()
         .any(|&x| x != b && b_border.binary_search(&x).is_ok())
+}
+
+/// `Q_ab` of exact quadrics (see [`super::pass_exact`]) for `a` and `b`, both unmoved in
+/// this pass: the face planes of the live triangles on both, then the segments joining
+/// them. `first` and `incident` are the pass's lists of triangles around each vertex;
+/// `triangles` holds the triangles from the number it is paired with on, which must
+/// include every triangle around `a` and `b`.
+///
+/// Walks the shorter of the two ends' lists: at a fan's centre, walking its own list
+/// for each of its edges was quadratic (found in review: a cylinder with
+/// 80,000-segment fan caps, 16.7 s against 0.5 s with summed quadrics). Either list
+/// holds the triangles on both ends in increasing order, so the sum is the same to the
+/// bit whichever is walked.
+pub(super) fn shared_planes(
+    first: &[u32],
+    incident: &[u32],
+    (first_triangle, triangles): (u32, &[[u32; 3]]),
+    exact: &PassExact,
+    [a, b]: [u32; 2],
+) -> Quadric {
+    let ((_, other), range) = shorter_list(first, a, b);
+    let mut sum = Quadric::ZERO;
+    for &t in &incident[range] {
+        let corners = triangles[(t - first_triangle) as usize];
+        if corners[0] != REMOVED && corners.contains(&other) {
+            sum += exact.face_quadric(t);
+        }
+    }
+    sum + exact.segments_between(a, b)
 }

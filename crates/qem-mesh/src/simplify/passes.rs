@@ -15,12 +15,11 @@
 //!    first when the round may reach the target), each checked like the greedy loop's
 //!    pairs (fold-over, merged faces, border loops, locks); then the attempted edges
 //!    and every edge at a moved vertex leave the batch, and the next round starts,
-//!    until the batch is empty or the target is reached. Without locks, exact
-//!    quadrics and the orientation check, and far from the target, the pairs of a
-//!    round whose neighbourhoods lie inside one block of vertex numbers are attempted
-//!    first, the blocks on the thread pool, and the rest after them in order
-//!    ([`super::pass_blocks`]). With the orientation check
-//!    on, a chunk of a round's pairs may first be *speculated* on the thread pool
+//!    until the batch is empty or the target is reached. Without locks, and far from
+//!    the target, the pairs of a round whose neighbourhoods lie inside one block of
+//!    vertex numbers are attempted first, the blocks on the thread pool, and the rest
+//!    after them in order ([`super::pass_blocks`]). With the orientation check on, a
+//!    chunk of the pairs attempted in order may first be *speculated* on the thread pool
 //!    (their placements and the check's quick tests, against the arrays as they are;
 //!    when most recent attempts contracted), and the attempts take what still holds
 //!    ([`PassEngine::speculate`] says why that is the sequential answer, bit for bit).
@@ -60,10 +59,10 @@ use super::options::QuadricMode;
 use super::options::{BoundaryMode, SimplifyOptions};
 use super::orientation::{InputSurface, Quick};
 use super::pass_blocks::{
-    contract_block, plain_checks, Around, BlockOutcome, Candidate, Corners, Fixed, Slab,
-    BLOCK_VERTICES, REMOVED,
+    contract_block, plain_checks, shared_planes, Around, BlockOutcome, Candidate, Corners, Fixed,
+    Slab, WaiverChange, BLOCK_VERTICES, REMOVED,
 };
-use super::pass_exact::{shorter_list, PassExact};
+use super::pass_exact::PassExact;
 use super::report::StopReason;
 use super::waivers::{penalised, Waivers};
 use crate::store::build::kept_triangles;
@@ -316,6 +315,9 @@ impl PassEngine {
             original_normals: &self.original_normals,
             vertex_from: &self.vertex_from,
             pass: self.pass,
+            exact: self.exact.as_ref(),
+            nearest: None,
+            waivers: &self.waivers,
         }
     }
 
@@ -339,6 +341,7 @@ impl PassEngine {
             quadric: &mut self.quadric,
             moved_in: &mut self.moved_in,
             triangles: &mut self.triangles,
+            hints: &mut [],
         };
         let fixed = Fixed {
             frame: &self.frame,
@@ -348,6 +351,9 @@ impl PassEngine {
             original_normals: &self.original_normals,
             vertex_from: &self.vertex_from,
             pass: self.pass,
+            exact: self.exact.as_ref(),
+            nearest: None,
+            waivers: &self.waivers,
         };
         (slab, fixed)
     }
@@ -368,13 +374,16 @@ impl PassEngine {
             .collect();
     }
 
-    /// Whether rounds are contracted block by block ([`super::pass_blocks`]): only
-    /// without the state the blocks do not split (locks, exact quadrics' planes, the
-    /// orientation check's hints and waivers), and only with more than one block.
+    /// Whether rounds are contracted block by block ([`super::pass_blocks`]): not with
+    /// locks (the lock check reads a locked neighbour's triangles, which may lie
+    /// outside the block), and only with more than one block.
     fn uses_blocks(&self) -> bool {
-        self.exact.is_none()
-            && self.input_surface.is_none()
-            && !self.settings.any_locked
+        let hints_per_triangle = self
+            .input_surface
+            .as_ref()
+            .is_none_or(|s| s.hint_count() == self.triangles.len());
+        !self.settings.any_locked
+            && hints_per_triangle
             && self.position.len() > self.block_vertices as usize
     }
 
@@ -388,38 +397,94 @@ impl PassEngine {
         deferred: &mut Vec<u32>,
         observer: &mut dyn Observer,
     ) -> BlockOutcome {
-        let candidates = std::mem::take(&mut self.candidates);
-        let block_vertices = self.block_vertices;
         let watch = observer.wants_contractions();
-        let block_triangles = std::mem::take(&mut self.block_triangles);
-        let (slab, fixed) = self.split();
-        let mut slabs: Vec<Option<Slab>> = slab
-            .into_blocks(block_vertices, &block_triangles)
+        let block_vertices = self.block_vertices;
+        let PassEngine {
+            frame,
+            settings,
+            first,
+            incident,
+            original_normals,
+            vertex_from,
+            pass,
+            exact,
+            input_surface,
+            waivers,
+            candidates,
+            block_triangles,
+            position,
+            world,
+            quadric,
+            moved_in,
+            triangles,
+            ..
+        } = self;
+        let (nearest, hints) = match input_surface {
+            Some(surface) => {
+                let (nearest, hints) = surface.parts();
+                (Some(nearest), hints)
+            }
+            None => (None, &mut [][..]),
+        };
+        let fixed = Fixed {
+            frame,
+            settings,
+            first,
+            incident,
+            original_normals,
+            vertex_from,
+            pass: *pass,
+            exact: exact.as_ref(),
+            nearest,
+            waivers,
+        };
+        let whole = Slab {
+            first_vertex: 0,
+            first_triangle: 0,
+            position,
+            world,
+            quadric,
+            moved_in,
+            triangles,
+            hints,
+        };
+        let mut slabs: Vec<Option<Slab>> = whole
+            .into_blocks(block_vertices, block_triangles)
             .into_iter()
             .map(Some)
             .collect();
         // The list is in order of the smaller end, so each block's pairs are one run.
+        let block_of = |i: u32| candidates[i as usize].a / block_vertices;
         let jobs: Vec<(Slab, &[u32])> = selected
-            .chunk_by(|&x, &y| {
-                candidates[x as usize].a / block_vertices
-                    == candidates[y as usize].a / block_vertices
-            })
-            .filter_map(|pairs| {
-                let block = candidates[pairs[0] as usize].a / block_vertices;
-                Some((slabs[block as usize].take()?, pairs))
-            })
+            .chunk_by(|&x, &y| block_of(x) == block_of(y))
+            .filter_map(|pairs| Some((slabs[block_of(pairs[0]) as usize].take()?, pairs)))
             .collect();
+        let candidates = &candidates[..];
         let outcomes: Vec<BlockOutcome> = jobs
             .into_par_iter()
-            .map(|(mut slab, pairs)| contract_block(&mut slab, &fixed, &candidates, pairs, watch))
+            .map(|(mut slab, pairs)| contract_block(&mut slab, &fixed, candidates, pairs, watch))
             .collect();
         drop(slabs);
-        self.block_triangles = block_triangles;
-        self.candidates = candidates;
+        // In block order, as if the blocks had run one after another.
         deferred.clear();
         let mut total = BlockOutcome::default();
         for outcome in outcomes {
             deferred.extend_from_slice(&outcome.deferred);
+            for change in &outcome.waiver_changes {
+                match *change {
+                    WaiverChange::Take(a, b) => {
+                        self.waivers.take(a, b);
+                    }
+                    WaiverChange::Waive(a, b) => self.waivers.waive(a, b),
+                    WaiverChange::Forget(v) => self.waivers.forget(v),
+                }
+            }
+            if let Some(exact) = &mut self.exact {
+                for change in &outcome.exact_changes {
+                    let collapsed = change.collapsed.iter().copied();
+                    exact.contract(change.kept, change.removed, collapsed);
+                }
+            }
             for contraction in &outcome.contractions {
                 observer.contracted(contraction);
             }
@@ -427,6 +492,7 @@ impl PassEngine {
             total.contracted += outcome.contracted;
             total.removed += outcome.removed;
             total.attempted += outcome.attempted;
+            total.waived += outcome.waived;
             total.over_bound |= outcome.over_bound;
         }
         total
@@ -965,25 +1031,10 @@ impl PassEngine {
         q
     }
 
-    /// `Q_ab` of exact quadrics (see [`super::pass_exact`]) for `a` and `b`, both
-    /// unmoved in this pass: the face planes of the live triangles on both, then the
-    /// segments joining them.
-    ///
-    /// Walks the shorter of the two ends' lists: at a fan's centre, walking its own
-    /// list for each of its edges was quadratic (found in review: a cylinder with
-    /// 80,000-segment fan caps, 16.7 s against 0.5 s with summed quadrics). Either list
-    /// holds the triangles on both ends in increasing order, so the sum is the same to
-    /// the bit whichever is walked.
+    /// `Q_ab` of exact quadrics for `a` and `b` ([`shared_planes`]).
     fn shared_planes(&self, exact: &PassExact, a: u32, b: u32) -> Quadric {
-        let ((_, other), range) = shorter_list(&self.first, a, b);
-        let mut sum = Quadric::ZERO;
-        for &t in &self.incident[range] {
-            let corners = self.triangles[t as usize];
-            if corners[0] != REMOVED && corners.contains(&other) {
-                sum += exact.face_quadric(t);
-            }
-        }
-        sum + exact.segments_between(a, b)
+        let triangles = (0, &self.triangles[..]);
+        shared_planes(&self.first, &self.incident, triangles, exact, [a, b])
     }
 
     /// Checks and contracts the edge `a b` (both unmoved in this pass); `live` is the

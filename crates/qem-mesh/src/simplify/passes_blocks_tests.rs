@@ -1,7 +1,8 @@
 //! Tests of the rounds contracted block by block (`pass_blocks`): small blocks on
-//! small messy meshes, so that blocks cut through every kind of neighbourhood; the
-//! output must not depend on the thread count, both the blocks and the sequential
-//! attempts must have work, and every output must be a valid mesh.
+//! small messy meshes, so that blocks cut through every kind of neighbourhood, with
+//! every option the pass-based order takes; the output must not depend on the thread
+//! count, both the blocks and the sequential attempts must have work, and every output
+//! must be a valid mesh.
 //!
 //! A wrong interior test (a triangle or corner outside the block read or written)
 //! shows as a panic here: the blocks' slices hold only their own vertices and
@@ -9,8 +10,8 @@
 //! test in `Slab::gather`, `blocks_cut_through_messy_meshes` panics.)
 
 use super::speculation_tests::{
-    accordion, book, grid, noise, ratios, rough_grid, run_levels, soup, unwelded, Levels, Seen,
-    Setup,
+    accordion, book, grid, noise, ratios, rough_grid, run_levels, soup, thin_lens, unwelded,
+    Levels, Seen, Setup,
 };
 use super::*;
 use crate::clean::CleanOptions;
@@ -57,8 +58,9 @@ fn same_on_any_thread_count(
     (on_two, seen)
 }
 
-/// The options that use blocks (no locks, summed quadrics, no orientation check),
-/// with each boundary mode and placement.
+/// The pass-based order's options, with each boundary mode and placement, summed or
+/// exact quadrics, with and without the orientation check (border locks keep the
+/// blocks off on a mesh with a border).
 fn block_options() -> Vec<SimplifyOptions> {
     let mut all = Vec::new();
     for boundary in [
@@ -71,11 +73,20 @@ fn block_options() -> Vec<SimplifyOptions> {
             PlacementMode::Optimal,
             PlacementMode::EndpointOrMidpoint,
         ] {
-            all.push(
-                SimplifyOptions::FAST
-                    .with_boundary(boundary)
-                    .with_placement(placement),
-            );
+            for (quadrics, check) in [
+                (QuadricMode::Sum, false),
+                (QuadricMode::Exact, false),
+                (QuadricMode::Sum, true),
+                (QuadricMode::Exact, true),
+            ] {
+                all.push(
+                    SimplifyOptions::FAST
+                        .with_boundary(boundary)
+                        .with_placement(placement)
+                        .with_quadrics(quadrics)
+                        .with_orientation_check(check),
+                );
+            }
         }
     }
     all
@@ -114,6 +125,18 @@ fn blocks_cut_through_messy_meshes() {
         seen.block_contractions > 0 && seen.block_deferrals > 0,
         "{seen:?}"
     );
+}
+
+/// With every default quality option: the orientation check refuses pairs inside the
+/// blocks (and waives them), and the output still does not depend on the thread count.
+#[test]
+fn blocks_with_exact_quadrics_and_the_orientation_check() {
+    let mesh = thin_lens(60, 120);
+    let options = SimplifyOptions::FAST
+        .with_quadrics(QuadricMode::Exact)
+        .with_orientation_check(true);
+    let (_, seen) = same_on_any_thread_count(&mesh, &options, &ratios(&mesh, &[0.05]), 1_000);
+    assert!(seen.block_contractions > 0 && seen.refused > 0, "{seen:?}");
 }
 
 /// A mesh of one block (or fewer vertices than a block) takes the sequential path
@@ -172,9 +195,11 @@ fn soup_block_options() -> impl Strategy<Value = SimplifyOptions> {
         prop_oneof![Just(Weighting::Area), Just(SimplifyOptions::FAST.weighting)],
         prop_oneof![Just(90.0), Just(180.0)],
         any::<bool>(),
+        prop_oneof![Just(QuadricMode::Sum), Just(QuadricMode::Exact)],
+        any::<bool>(),
     )
         .prop_map(
-            |(boundary, placement, weighting, angle, weld)| SimplifyOptions {
+            |(boundary, placement, weighting, angle, weld, quadrics, check)| SimplifyOptions {
                 clean: CleanOptions::DEFAULT
                     .with_weld_exact(weld)
                     .with_drop_duplicates(weld)
@@ -184,6 +209,8 @@ fn soup_block_options() -> impl Strategy<Value = SimplifyOptions> {
                     .with_placement(placement)
                     .with_weighting(weighting)
                     .with_max_normal_angle(angle)
+                    .with_quadrics(quadrics)
+                    .with_orientation_check(check)
             },
         )
 }

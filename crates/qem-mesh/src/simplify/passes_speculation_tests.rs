@@ -14,7 +14,7 @@ use proptest::prelude::*;
 /// A UV sphere squashed to a thin lens (height 0.04 of its width) with a
 /// deterministic wobble: at ratio 0.05 the rim's faces come near input faces of the
 /// other side, so the orientation check refuses pairs.
-fn thin_lens(rings: u32, segments: u32) -> IndexedMesh {
+pub(super) fn thin_lens(rings: u32, segments: u32) -> IndexedMesh {
     let mut positions = vec![[0.0, 0.0, 0.02]];
     for i in 1..rings {
         let theta = std::f64::consts::PI * f64::from(i) / f64::from(rings);

@@ -41,6 +41,12 @@ impl Waivers {
         }
     }
 
+    /// Whether `v` is an end of a waived pair.
+    #[inline]
+    pub fn involves(&self, v: u32) -> bool {
+        self.flagged[v as usize]
+    }
+
     /// Whether no pair is waived.
     pub fn is_empty(&self) -> bool {
         self.partners.is_empty()
