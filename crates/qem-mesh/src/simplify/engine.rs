@@ -260,8 +260,9 @@ pub(super) struct Counters {
 }
 
 impl Counters {
-    /// Adds `other`'s counts to these and keeps the larger of the two largest errors
-    /// (the counts of one block of a pass, see `pass_blocks`).
+    /// Adds `other`'s counts of what happened to these and keeps the larger of the two
+    /// largest errors (the counts of one block of a pass, see `pass_blocks`;
+    /// `locked_vertices` is a property of the run, not counted there).
     pub(super) fn absorb(&mut self, other: &Counters) {
         self.edge_contractions += other.edge_contractions;
         self.virtual_contractions += other.virtual_contractions;
@@ -276,7 +277,6 @@ impl Counters {
         self.rejected_border += other.rejected_border;
         self.rejected_merge += other.rejected_merge;
         self.rejected_orientation += other.rejected_orientation;
-        self.locked_vertices += other.locked_vertices;
     }
 
     pub(super) fn reject(&mut self, why: Rejection) {

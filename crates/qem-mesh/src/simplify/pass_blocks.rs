@@ -17,7 +17,8 @@
 //! changes to the last two are made after the blocks, in block order.
 //!
 //! Not with locked vertices: the lock check looks at a locked neighbour's triangles,
-//! which may lie outside the block.
+//! which may lie outside the block. (Nor, with the orientation check, if the hints
+//! were not one per triangle, which seeding them always makes them.)
 //!
 //! The order is fixed by the numbers, not by the threads: in a round, the interior
 //! pairs of each block are attempted in the round's order, blocks one after another as

@@ -187,6 +187,10 @@ pub(super) struct PassEngine {
     /// they left to the sequential attempts (for tests).
     block_contractions: usize,
     block_deferrals: usize,
+    /// Tests only: instead of the blocks, attempt a round's interior pairs and then
+    /// the others in order, all by the sequential attempts (the order the blocks must
+    /// give the result of; see `interior_first`).
+    blocks_in_order: bool,
     since_report: usize,
     /// The input surface for the orientation check; `None` when the check is off.
     input_surface: Option<InputSurface>,
@@ -270,6 +274,7 @@ impl PassEngine {
             verdicts_asked_again: 0,
             block_contractions: 0,
             block_deferrals: 0,
+            blocks_in_order: false,
             since_report: 0,
             input_surface: None,
             waivers: Waivers::new(n),
@@ -455,10 +460,17 @@ impl PassEngine {
             .collect();
         // The list is in order of the smaller end, so each block's pairs are one run.
         let block_of = |i: u32| candidates[i as usize].a / block_vertices;
-        let jobs: Vec<(Slab, &[u32])> = selected
-            .chunk_by(|&x, &y| block_of(x) == block_of(y))
-            .filter_map(|pairs| Some((slabs[block_of(pairs[0]) as usize].take()?, pairs)))
-            .collect();
+        // (A second run for the same block cannot happen: `selected` is in list order.
+        // Were it to, its pairs would go to the sequential attempts, in order.)
+        let mut strays = Vec::new();
+        let mut jobs: Vec<(Slab, &[u32])> = Vec::new();
+        for pairs in selected.chunk_by(|&x, &y| block_of(x) == block_of(y)) {
+            match slabs[block_of(pairs[0]) as usize].take() {
+                Some(slab) => jobs.push((slab, pairs)),
+                None => strays.extend_from_slice(pairs),
+            }
+        }
+        debug_assert!(strays.is_empty(), "a round's pairs out of list order");
         let candidates = &candidates[..];
         let outcomes: Vec<BlockOutcome> = jobs
             .into_par_iter()
@@ -467,6 +479,7 @@ impl PassEngine {
         drop(slabs);
         // In block order, as if the blocks had run one after another.
         deferred.clear();
+        deferred.extend_from_slice(&strays);
         let mut total = BlockOutcome::default();
         for outcome in outcomes {
             deferred.extend_from_slice(&outcome.deferred);
@@ -494,6 +507,10 @@ impl PassEngine {
             total.attempted += outcome.attempted;
             total.waived += outcome.waived;
             total.over_bound |= outcome.over_bound;
+        }
+        if !strays.is_empty() {
+            // Candidate indices are the list order.
+            deferred.sort_unstable();
         }
         total
     }
@@ -787,14 +804,30 @@ impl PassEngine {
             // thread pool; the others follow in order (see `pass_blocks`). Each
             // interior contraction removes at most two triangles, so the target
             // cannot be passed among them.
-            let attempts = if !may_reach_target && self.uses_blocks() {
+            let attempts = if !may_reach_target && self.uses_blocks() && self.blocks_in_order {
+                self.interior_first(&selected, &mut deferred);
+                &deferred
+            } else if !may_reach_target && self.uses_blocks() {
                 let blocks = self.contract_blocks(&selected, &mut deferred, observer);
                 live_count -= blocks.removed;
                 contracted += blocks.contracted;
+                waived += blocks.waived;
                 self.block_contractions += blocks.contracted;
                 self.block_deferrals += deferred.len();
                 over_bound |= blocks.over_bound;
                 self.since_report += blocks.attempted;
+                if self.since_report >= OBSERVER_INTERVAL {
+                    self.since_report = 0;
+                    observer.progress(Progress {
+                        triangles: live_count,
+                        triangles_start: start,
+                        target,
+                    });
+                    if observer.should_stop() {
+                        end = Some(PassEnd::Cancelled);
+                        break 'rounds;
+                    }
+                }
                 &deferred
             } else {
                 &selected
@@ -1388,6 +1421,45 @@ impl PassEngine {
             }
         }
         false
+    }
+
+    /// Tests only: `selected` (a round, in list order) into `order` with the pairs
+    /// interior to their block first, then the others, each in list order; found here
+    /// independently of [`Slab::gather`], at the round's start (a contraction inside a
+    /// block keeps its triangles' corners in the block, so a pair's standing cannot
+    /// change during the round).
+    fn interior_first(&self, selected: &[u32], order: &mut Vec<u32>) {
+        let layout_block = |v: u32| v / self.block_vertices;
+        let n = self.position.len() as u32;
+        let interior = |i: u32| {
+            let Candidate { a, b, .. } = self.candidates[i as usize];
+            let k = layout_block(a);
+            let vertices = k * self.block_vertices..((k + 1) * self.block_vertices).min(n);
+            let triangles = self.block_triangles[k as usize]..self.block_triangles[k as usize + 1];
+            let mut shared = 0;
+            for v in [a, b] {
+                let range = self.first[v as usize] as usize..self.first[v as usize + 1] as usize;
+                for &t in &self.incident[range] {
+                    if !triangles.contains(&t) {
+                        return false;
+                    }
+                    let corners = self.triangles[t as usize];
+                    if corners[0] == REMOVED {
+                        continue;
+                    }
+                    if !corners.iter().all(|c| vertices.contains(c)) {
+                        return false;
+                    }
+                    if v == a && corners.contains(&b) {
+                        shared += 1;
+                    }
+                }
+            }
+            shared <= 2
+        };
+        order.clear();
+        order.extend(selected.iter().copied().filter(|&i| interior(i)));
+        order.extend(selected.iter().copied().filter(|&i| !interior(i)));
     }
 
     /// Takes the removed triangles off the live list, ending the pass.

@@ -107,6 +107,7 @@ pub(super) fn run_levels(
         if let Some(block_vertices) = setup.block_vertices {
             engine.set_block_vertices(block_vertices);
         }
+        engine.blocks_in_order = setup.blocks_in_order;
         let mut levels = Vec::new();
         for &target in targets {
             let reason = engine.run(target, &mut NoObserver);
@@ -136,12 +137,16 @@ pub(super) fn run_levels(
     })
 }
 
-/// How a test run sets the engine up: whether it speculates, and the vertices per
-/// block of `pass_blocks` (`None`: the engine's own).
+/// How a test run sets the engine up: whether it speculates, the vertices per block of
+/// `pass_blocks` (`None`: the engine's own), and whether the blocks' order is run
+/// sequentially instead.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Setup {
     pub speculation: bool,
     pub block_vertices: Option<u32>,
+    /// Instead of the blocks, their order run by the sequential attempts (see
+    /// `PassEngine::interior_first`).
+    pub blocks_in_order: bool,
 }
 
 /// What a run did: orientation verdicts taken from a speculation and asked again,
@@ -162,6 +167,7 @@ fn assert_same(mesh: &IndexedMesh, options: &SimplifyOptions, targets: &[usize])
     let plain_setup = Setup {
         speculation: false,
         block_vertices: None,
+        blocks_in_order: false,
     };
     let (sequential, plain) = run_levels(mesh, options, targets, plain_setup, 2);
     assert_eq!(plain.reused + plain.asked_again, 0);
