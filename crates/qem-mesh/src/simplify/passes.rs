@@ -207,6 +207,26 @@ pub(super) struct PassEngine {
     deferred: Vec<u32>,
 }
 
+/// A [`Fixed`] borrowing the fields of the engine `$engine`, with the orientation
+/// check's index `$nearest`. A macro rather than a method so that it can borrow those
+/// fields beside mutable borrows of the engine's others (the [`Slab`]).
+macro_rules! fixed_of {
+    ($engine:expr, $nearest:expr) => {
+        Fixed {
+            frame: &$engine.frame,
+            settings: &$engine.settings,
+            first: &$engine.first,
+            incident: &$engine.incident,
+            original_normals: &$engine.original_normals,
+            vertex_from: &$engine.vertex_from,
+            pass: $engine.pass,
+            exact: $engine.exact.as_ref(),
+            nearest: $nearest,
+            waivers: &$engine.waivers,
+        }
+    };
+}
+
 impl PassEngine {
     /// Face quadrics summed into vertex quadrics, border planes or locks, locked
     /// vertices; `locked` lists cleaned-mesh indices.
@@ -312,18 +332,7 @@ impl PassEngine {
     /// What no contraction of the pass changes, for the shared pieces of an attempt
     /// ([`super::pass_blocks`]).
     fn fixed(&self) -> Fixed<'_> {
-        Fixed {
-            frame: &self.frame,
-            settings: &self.settings,
-            first: &self.first,
-            incident: &self.incident,
-            original_normals: &self.original_normals,
-            vertex_from: &self.vertex_from,
-            pass: self.pass,
-            exact: self.exact.as_ref(),
-            nearest: None,
-            waivers: &self.waivers,
-        }
+        fixed_of!(self, None)
     }
 
     /// Every vertex's positions, for the fold-over check.
@@ -348,18 +357,7 @@ impl PassEngine {
             triangles: &mut self.triangles,
             hints: &mut [],
         };
-        let fixed = Fixed {
-            frame: &self.frame,
-            settings: &self.settings,
-            first: &self.first,
-            incident: &self.incident,
-            original_normals: &self.original_normals,
-            vertex_from: &self.vertex_from,
-            pass: self.pass,
-            exact: self.exact.as_ref(),
-            nearest: None,
-            waivers: &self.waivers,
-        };
+        let fixed = fixed_of!(self, None);
         (slab, fixed)
     }
 
@@ -404,55 +402,25 @@ impl PassEngine {
     ) -> BlockOutcome {
         let watch = observer.wants_contractions();
         let block_vertices = self.block_vertices;
-        let PassEngine {
-            frame,
-            settings,
-            first,
-            incident,
-            original_normals,
-            vertex_from,
-            pass,
-            exact,
-            input_surface,
-            waivers,
-            candidates,
-            block_triangles,
-            position,
-            world,
-            quadric,
-            moved_in,
-            triangles,
-            ..
-        } = self;
-        let (nearest, hints) = match input_surface {
+        let (nearest, hints) = match &mut self.input_surface {
             Some(surface) => {
                 let (nearest, hints) = surface.parts();
                 (Some(nearest), hints)
             }
             None => (None, &mut [][..]),
         };
-        let fixed = Fixed {
-            frame,
-            settings,
-            first,
-            incident,
-            original_normals,
-            vertex_from,
-            pass: *pass,
-            exact: exact.as_ref(),
-            nearest,
-            waivers,
-        };
+        let fixed = fixed_of!(self, nearest);
         let whole = Slab {
             first_vertex: 0,
             first_triangle: 0,
-            position,
-            world,
-            quadric,
-            moved_in,
-            triangles,
+            position: &mut self.position,
+            world: &mut self.world,
+            quadric: &mut self.quadric,
+            moved_in: &mut self.moved_in,
+            triangles: &mut self.triangles,
             hints,
         };
+        let (candidates, block_triangles) = (&self.candidates, &self.block_triangles);
         let mut slabs: Vec<Option<Slab>> = whole
             .into_blocks(block_vertices, block_triangles)
             .into_iter()
@@ -471,7 +439,6 @@ impl PassEngine {
             }
         }
         debug_assert!(strays.is_empty(), "a round's pairs out of list order");
-        let candidates = &candidates[..];
         let outcomes: Vec<BlockOutcome> = jobs
             .into_par_iter()
             .map(|(mut slab, pairs)| contract_block(&mut slab, &fixed, candidates, pairs, watch))
