@@ -29,8 +29,9 @@
 //! Measured before this existed, on the dragon at ratio 0.1: with `--fast`, the rounds'
 //! sequential attempts were about 600 ms of the 960 ms contraction phase; with every
 //! default quality option, the attempts (0.88 s) and their speculation on both cores
-//! (0.87 s) were most of 2.6 s. With blocks of 16,384 vertices, 87–93% of the pairs of
-//! a pass's first round were interior. (BENCHMARKS.md, "Rounds block by block".)
+//! (0.87 s) were most of 2.6 s. With blocks of 16,384 vertices, 89–93% of the pairs of
+//! the first round of passes 1-3 were interior (counted in a scratch build). (BENCHMARKS.md,
+//! "Rounds block by block".)
 
 use super::checks::{moved_face_verdict, Rejection};
 use super::engine::{place_merged, Counters, Settings};
