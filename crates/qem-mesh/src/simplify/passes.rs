@@ -782,18 +782,9 @@ impl PassEngine {
                 self.block_contractions += blocks.contracted;
                 self.block_deferrals += deferred.len();
                 over_bound |= blocks.over_bound;
-                self.since_report += blocks.attempted;
-                if self.since_report >= OBSERVER_INTERVAL {
-                    self.since_report = 0;
-                    observer.progress(Progress {
-                        triangles: live_count,
-                        triangles_start: start,
-                        target,
-                    });
-                    if observer.should_stop() {
-                        end = Some(PassEnd::Cancelled);
-                        break 'rounds;
-                    }
+                if self.count_attempts(blocks.attempted, [live_count, start, target], observer) {
+                    end = Some(PassEnd::Cancelled);
+                    break 'rounds;
                 }
                 &deferred
             } else {
@@ -831,18 +822,9 @@ impl PassEngine {
                     // Never contracted; the pass goes on with the pairs under the bound.
                     Attempt::OverErrorBound => over_bound = true,
                 }
-                self.since_report += 1;
-                if self.since_report >= OBSERVER_INTERVAL {
-                    self.since_report = 0;
-                    observer.progress(Progress {
-                        triangles: live_count,
-                        triangles_start: start,
-                        target,
-                    });
-                    if observer.should_stop() {
-                        end = Some(PassEnd::Cancelled);
-                        break 'rounds;
-                    }
+                if self.count_attempts(1, [live_count, start, target], observer) {
+                    end = Some(PassEnd::Cancelled);
+                    break 'rounds;
                 }
             }
             // Attempted edges leave the batch (a refused one is asked again next
@@ -868,6 +850,28 @@ impl PassEngine {
             None if contracted == 0 && waived == 0 && over_bound => PassEnd::MaxErrorReached,
             None => PassEnd::Done { contracted, waived },
         }
+    }
+
+    /// Counts `attempted` more attempts and, every [`OBSERVER_INTERVAL`] of them, tells
+    /// the observer the live triangle count (of the run's `start`, towards `target`) and
+    /// asks whether to stop: `true` when it says so.
+    fn count_attempts(
+        &mut self,
+        attempted: usize,
+        [live, start, target]: [usize; 3],
+        observer: &mut dyn Observer,
+    ) -> bool {
+        self.since_report += attempted;
+        if self.since_report < OBSERVER_INTERVAL {
+            return false;
+        }
+        self.since_report = 0;
+        observer.progress(Progress {
+            triangles: live,
+            triangles_start: start,
+            target,
+        });
+        observer.should_stop()
     }
 
     /// The indices of this pass's batch, the `take` cheapest edges, into `batch`, in

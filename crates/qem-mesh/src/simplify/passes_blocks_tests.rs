@@ -10,12 +10,11 @@
 //! test in `Slab::gather`, `blocks_cut_through_messy_meshes` panics.)
 
 use super::speculation_tests::{
-    accordion, book, grid, noise, ratios, rough_grid, run_levels, soup, thin_lens, unwelded,
-    Levels, Seen, Setup,
+    accordion, book, grid, noise, ratios, rough_grid, run_levels, soup, soup_options, thin_lens,
+    unwelded, Levels, Seen, Setup,
 };
 use super::*;
-use crate::clean::CleanOptions;
-use crate::simplify::{PlacementMode, Weighting};
+use crate::simplify::PlacementMode;
 use proptest::prelude::*;
 
 /// Runs `mesh` to each of `targets` with blocks of `block_vertices` on 1, 2 and 4
@@ -276,35 +275,19 @@ fn blocks_follow_the_numbers_not_the_surface() {
     }
 }
 
+/// The speculation tests' options for soups, made to use the blocks: no locked
+/// vertices (border locks become border planes), and the orientation check on or off.
 fn soup_block_options() -> impl Strategy<Value = SimplifyOptions> {
-    (
-        prop_oneof![Just(BoundaryMode::Free), Just(BoundaryMode::Planes(1.0))],
-        prop_oneof![
-            Just(PlacementMode::SolveFirst),
-            Just(PlacementMode::Optimal),
-            Just(PlacementMode::EndpointOrMidpoint)
-        ],
-        prop_oneof![Just(Weighting::Area), Just(SimplifyOptions::FAST.weighting)],
-        prop_oneof![Just(90.0), Just(180.0)],
-        any::<bool>(),
-        prop_oneof![Just(QuadricMode::Sum), Just(QuadricMode::Exact)],
-        any::<bool>(),
-    )
-        .prop_map(
-            |(boundary, placement, weighting, angle, weld, quadrics, check)| SimplifyOptions {
-                clean: CleanOptions::DEFAULT
-                    .with_weld_exact(weld)
-                    .with_drop_duplicates(weld)
-                    .with_drop_repeated_index(weld),
-                ..SimplifyOptions::FAST
-                    .with_boundary(boundary)
-                    .with_placement(placement)
-                    .with_weighting(weighting)
-                    .with_max_normal_angle(angle)
-                    .with_quadrics(quadrics)
-                    .with_orientation_check(check)
-            },
-        )
+    (soup_options(), any::<bool>()).prop_map(|(options, check)| {
+        let boundary = match options.boundary {
+            BoundaryMode::Locked => BoundaryMode::Planes(1.0),
+            other => other,
+        };
+        options
+            .with_locked_vertices(Vec::new())
+            .with_boundary(boundary)
+            .with_orientation_check(check)
+    })
 }
 
 proptest! {

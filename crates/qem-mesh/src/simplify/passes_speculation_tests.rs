@@ -477,7 +477,7 @@ pub(super) fn soup(max_vertices: usize) -> impl Strategy<Value = IndexedMesh> {
     })
 }
 
-fn soup_options() -> impl Strategy<Value = SimplifyOptions> {
+pub(super) fn soup_options() -> impl Strategy<Value = SimplifyOptions> {
     (
         prop_oneof![
             Just(BoundaryMode::Free),
