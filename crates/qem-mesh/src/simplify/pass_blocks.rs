@@ -528,7 +528,7 @@ pub(super) fn plain_checks(
 /// [`SMALL_STAR`] triangles), a dozen numbers on the stack, about half the
 /// instructions of the search of the other triangles per corner that this replaced;
 /// for a vertex with thousands of triangles (a fan), k log k steps, not k².
-fn border_neighbours(v: u32, around: &[Around]) -> SmallVec<[u32; 8]> {
+pub(super) fn border_neighbours(v: u32, around: &[Around]) -> SmallVec<[u32; 8]> {
     if around.len() > SMALL_STAR {
         let mut ends: Vec<u32> = around
             .iter()

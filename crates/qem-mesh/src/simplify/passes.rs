@@ -59,8 +59,8 @@ use super::options::QuadricMode;
 use super::options::{BoundaryMode, SimplifyOptions};
 use super::orientation::{InputSurface, Quick};
 use super::pass_blocks::{
-    contract_block, plain_checks, shared_planes, Around, BlockOutcome, Candidate, Corners, Fixed,
-    Slab, WaiverChange, BLOCK_VERTICES, REMOVED,
+    border_neighbours, contract_block, plain_checks, shared_planes, Around, BlockOutcome,
+    Candidate, Corners, Fixed, Slab, WaiverChange, BLOCK_VERTICES, REMOVED,
 };
 use super::pass_exact::PassExact;
 use super::report::StopReason;
@@ -265,7 +265,9 @@ impl PassEngine {
             world: mesh.positions,
             vertex_from,
             triangle_from,
-            quadric: vec![Quadric::default(); n],
+            // Summed by `sum_face_planes` (a filled array made first was 80 bytes a
+            // vertex of pages written twice).
+            quadric: Vec::new(),
             locked: vec![false; n],
             triangles: mesh.triangles,
             live,
@@ -492,14 +494,17 @@ impl PassEngine {
     /// depend on the thread count). Needs the incident lists. Returns the weighting's
     /// constant added to face areas (`None`: unit weights).
     fn sum_face_planes(&mut self, options: &SimplifyOptions) -> Option<f64> {
-        let areas: f64 = self
+        // The areas on both cores, summed on one in the order of `live`: the bits of
+        // that order, whatever the thread count.
+        let areas: Vec<f64> = self
             .live
-            .iter()
+            .par_iter()
             .map(|&t| {
                 let [a, b, c] = self.corners(self.triangles[t as usize]);
                 unit_normal_and_area(a, b, c).map_or(0.0, |(_, area)| area)
             })
-            .sum();
+            .collect();
+        let areas: f64 = areas.iter().sum();
         let mean_area = if self.live.is_empty() {
             0.0
         } else {
@@ -539,16 +544,16 @@ impl PassEngine {
         // whatever the thread count. (Made from the plane at each corner rather than
         // kept per triangle: 80 bytes a triangle saved.)
         let (first, incident) = (&self.first, &self.incident);
-        self.quadric
-            .par_iter_mut()
-            .enumerate()
-            .for_each(|(v, quadric)| {
+        self.quadric = (0..self.position.len())
+            .into_par_iter()
+            .map(|v| {
                 let mut sum = Quadric::default();
                 for &t in &incident[first[v] as usize..first[v + 1] as usize] {
                     sum += planes[t as usize].quadric();
                 }
-                *quadric = sum;
-            });
+                sum
+            })
+            .collect();
         self.original_normals = normals;
         if let Some(exact) = &mut self.exact {
             exact.set_face_planes(planes);
@@ -604,15 +609,11 @@ impl PassEngine {
     /// Border planes ([`BoundaryMode::Planes`]) or border locks ([`BoundaryMode::Locked`]),
     /// as the greedy loop adds them: a border edge is an edge of exactly one triangle.
     ///
-    /// Each vertex's neighbours are counted in a table indexed by vertex (`best`,
-    /// borrowed and given back as it was), then the ones counted once are read off in
-    /// the order of the vertex's triangles (the order of the sums, so of the bits).
-    /// A per-corner search of the other triangles, which this replaced, was 62 M of
-    /// the 868 M instructions of a `--fast` run on dragon_res2; this is a quarter. The
-    /// order is the one that search gave for stars of up to 16 triangles; above that,
-    /// the search sorted by neighbour, so a border vertex with more triangles may sum
-    /// its border planes in another order than before 3b173b8 (in review, 172 open fans
-    /// of 17 to 59 triangles still gave identical outputs).
+    /// The border edges are found on the thread pool, each vertex's from its smaller
+    /// end by [`border_neighbours`], in the order of the vertex's triangles; then added
+    /// on one core in vertex order, so the sums, and their bits, are the same whatever
+    /// the thread count. (The search on one core, with a table of counts indexed by
+    /// vertex, was 53 of the 178 ms of the dragon's `--fast` setup.)
     fn initialise_boundary(&mut self, options: &SimplifyOptions, area_offset: Option<f64>) {
         let weight = match options.boundary {
             BoundaryMode::Free => return,
@@ -620,55 +621,46 @@ impl PassEngine {
             BoundaryMode::Planes(_) => return,
             BoundaryMode::Locked => None,
         };
-        let mut count = std::mem::take(&mut self.best);
-        let mut border = Vec::new();
-        for v in 0..self.position.len() as u32 {
-            let range = self.first[v as usize] as usize..self.first[v as usize + 1] as usize;
-            let around = &self.incident[range];
-            // Live triangles have distinct corners, so a neighbour's count is the
-            // number of `v`'s triangles that hold it. (`count` is u32::MAX between
-            // vertices; wrapping makes the first increment give 0, hence `== 0`.)
-            for &t in around {
-                for c in self.triangles[t as usize] {
-                    if c != v {
-                        count[c as usize] = count[c as usize].wrapping_add(1);
-                    }
-                }
-            }
-            border.clear();
-            for &t in around {
-                for c in self.triangles[t as usize] {
-                    if c != v {
-                        if count[c as usize] == 0 && c > v {
-                            // each border edge once, from its smaller end
-                            border.push((c, t));
+        // (smaller end, larger end, the edge's triangle)
+        let borders: Vec<(u32, u32, u32)> = (0..self.position.len() as u32)
+            .into_par_iter()
+            .map_init(Vec::new, |around, v| {
+                self.gather(v, around);
+                let ends = border_neighbours(v, around);
+                let mut found = SmallVec::<[(u32, u32, u32); 4]>::new();
+                if ends.last().is_some_and(|&last| last > v) {
+                    for x in around.iter() {
+                        for c in x.corners {
+                            if c > v && ends.binary_search(&c).is_ok() {
+                                found.push((v, c, x.triangle));
+                            }
                         }
-                        count[c as usize] = u32::MAX;
                     }
                 }
-            }
-            for &(x, t) in &border {
-                let Some(w) = weight else {
-                    self.locked[v as usize] = true;
-                    self.locked[x as usize] = true;
-                    continue;
-                };
-                let [p0, p1, p2] = self.corners(self.triangles[t as usize]);
-                let normal = (p1 - p0).cross(p2 - p0).normalize_or_zero();
-                let (pa, pb) = (self.position[v as usize], self.position[x as usize]);
-                let plane_weight = match area_offset {
-                    Some(extra) => w * (pa.distance_squared(pb) + extra),
-                    None => w,
-                };
-                let q = Quadric::boundary_constraint(pa, pb, normal, plane_weight);
-                self.quadric[v as usize] += q;
-                self.quadric[x as usize] += q;
-                if let Some(exact) = &mut self.exact {
-                    exact.add_border_plane(v, x, q);
-                }
+                found
+            })
+            .flat_map_iter(|found| found)
+            .collect();
+        for (v, x, t) in borders {
+            let Some(w) = weight else {
+                self.locked[v as usize] = true;
+                self.locked[x as usize] = true;
+                continue;
+            };
+            let [p0, p1, p2] = self.corners(self.triangles[t as usize]);
+            let normal = (p1 - p0).cross(p2 - p0).normalize_or_zero();
+            let (pa, pb) = (self.position[v as usize], self.position[x as usize]);
+            let plane_weight = match area_offset {
+                Some(extra) => w * (pa.distance_squared(pb) + extra),
+                None => w,
+            };
+            let q = Quadric::boundary_constraint(pa, pb, normal, plane_weight);
+            self.quadric[v as usize] += q;
+            self.quadric[x as usize] += q;
+            if let Some(exact) = &mut self.exact {
+                exact.add_border_plane(v, x, q);
             }
         }
-        self.best = count;
     }
 
     /// Contracts until `target` triangles are left, the error bound, no contraction
