@@ -4,7 +4,8 @@
 //! vertex; faces that repeat a vertex, have zero area or repeat another face are
 //! dropped, by `qem_mesh::clean` with its default passes), so both tools get the same
 //! indexed mesh and the same target triangle count, `floor(ratio x welded triangles)`.
-//! Each tool then runs several times on it and the median wall time is reported.
+//! Each tool then runs several times on it, the two taking turns run by run, and the
+//! median wall time is reported.
 //!
 //! - qem: `qem_mesh::simplify::simplify` with `SimplifyOptions::DEFAULT` (t = 0,
 //!   optimal placement, area weighting) and `Target::Triangles(target)`. The timed call
@@ -308,18 +309,38 @@ fn timed<T>(f: impl FnOnce() -> T) -> (T, f64, Option<f64>) {
     (out, wall, cpu)
 }
 
-/// Median wall and CPU seconds of a list of runs.
-fn medians(wall: &mut [f64], cpu: &mut [Option<f64>]) -> (f64, Option<f64>) {
-    let mut cpu: Option<Vec<f64>> = cpu.iter().copied().collect();
-    (median(wall), cpu.as_deref_mut().map(median))
+/// One tool's runs: wall and CPU seconds, and the output's triangle count.
+#[derive(Default)]
+struct Samples {
+    wall: Vec<f64>,
+    cpu: Vec<Option<f64>>,
+    triangles_out: usize,
 }
 
-fn run_qem(
-    mesh: &IndexedMesh,
-    target: usize,
-    runs: usize,
-    args: &Args,
-) -> Result<Measured, String> {
+impl Samples {
+    /// Adds one run's output triangle count, wall and CPU seconds.
+    fn push(&mut self, (triangles_out, wall, cpu): (usize, f64, Option<f64>)) {
+        self.wall.push(wall);
+        self.cpu.push(cpu);
+        self.triangles_out = triangles_out;
+    }
+
+    /// The medians, or `None` without runs.
+    fn measured(mut self) -> Option<Measured> {
+        if self.wall.is_empty() {
+            return None;
+        }
+        let mut cpu: Option<Vec<f64>> = self.cpu.iter().copied().collect();
+        Some(Measured {
+            seconds: median(&mut self.wall),
+            cpu_seconds: cpu.as_deref_mut().map(median),
+            triangles_out: self.triangles_out,
+        })
+    }
+}
+
+/// qem's options for a run of the bench to `target` triangles.
+fn qem_options(args: &Args, target: usize) -> SimplifyOptions {
     let base = if args.fast {
         SimplifyOptions::FAST
             .with_orientation_check(args.orientation_check)
@@ -331,67 +352,52 @@ fn run_qem(
     } else {
         SimplifyOptions::DEFAULT
     };
-    let options = base.with_target(Target::Triangles(target));
-    let (mut times, mut cpu_times) = (Vec::with_capacity(runs), Vec::with_capacity(runs));
-    let mut triangles_out = 0;
-    for run in 0..runs {
-        let (out, wall, cpu) = timed(|| simplify(mesh, &options));
-        let out = out.map_err(|e| format!("qem: {e}"))?;
-        times.push(wall);
-        cpu_times.push(cpu);
-        triangles_out = out.mesh.triangle_count();
-        let t = out.report.timings;
-        eprintln!(
-            "  qem run {run}: clean {:.3} s, build {:.3} s, setup {:.3} s, contract {:.3} s, \
-             compact {:.3} s",
-            t.clean.as_secs_f64(),
-            t.build.as_secs_f64(),
-            t.setup.as_secs_f64(),
-            t.contract.as_secs_f64(),
-            t.compact.as_secs_f64()
-        );
-        std::hint::black_box(out);
-    }
-    let (seconds, cpu_seconds) = medians(&mut times, &mut cpu_times);
-    Ok(Measured {
-        seconds,
-        cpu_seconds,
-        triangles_out,
-    })
+    base.with_target(Target::Triangles(target))
 }
 
-fn run_meshopt(
-    positions: &[f32],
+/// One timed qem run (number `run`, for the phase timings it prints): output triangle
+/// count, wall and CPU seconds.
+fn qem_once(
+    mesh: &IndexedMesh,
+    options: &SimplifyOptions,
+    run: usize,
+) -> Result<(usize, f64, Option<f64>), String> {
+    let (out, wall, cpu) = timed(|| simplify(mesh, options));
+    let out = out.map_err(|e| format!("qem: {e}"))?;
+    let t = out.report.timings;
+    eprintln!(
+        "  qem run {run}: clean {:.3} s, build {:.3} s, setup {:.3} s, contract {:.3} s, \
+         compact {:.3} s",
+        t.clean.as_secs_f64(),
+        t.build.as_secs_f64(),
+        t.setup.as_secs_f64(),
+        t.contract.as_secs_f64(),
+        t.compact.as_secs_f64()
+    );
+    let triangles_out = out.mesh.triangle_count();
+    std::hint::black_box(out);
+    Ok((triangles_out, wall, cpu))
+}
+
+/// One timed meshopt run: output triangle count, wall and CPU seconds.
+fn meshopt_once(
+    adapter: &meshopt::VertexDataAdapter,
     indices: &[u32],
     target: usize,
-    runs: usize,
-) -> Result<Measured, String> {
-    let bytes = meshopt::typed_to_bytes(positions);
-    let adapter = meshopt::VertexDataAdapter::new(bytes, 12, 0).map_err(|e| e.to_string())?;
-    let (mut times, mut cpu_times) = (Vec::with_capacity(runs), Vec::with_capacity(runs));
-    let mut triangles_out = 0;
-    for _ in 0..runs {
-        let (out, wall, cpu) = timed(|| {
-            meshopt::simplify(
-                indices,
-                &adapter,
-                target * 3,
-                f32::MAX,
-                meshopt::SimplifyOptions::None,
-                None,
-            )
-        });
-        times.push(wall);
-        cpu_times.push(cpu);
-        triangles_out = out.len() / 3;
-        std::hint::black_box(out);
-    }
-    let (seconds, cpu_seconds) = medians(&mut times, &mut cpu_times);
-    Ok(Measured {
-        seconds,
-        cpu_seconds,
-        triangles_out,
-    })
+) -> (usize, f64, Option<f64>) {
+    let (out, wall, cpu) = timed(|| {
+        meshopt::simplify(
+            indices,
+            adapter,
+            target * 3,
+            f32::MAX,
+            meshopt::SimplifyOptions::None,
+            None,
+        )
+    });
+    let triangles_out = out.len() / 3;
+    std::hint::black_box(out);
+    (triangles_out, wall, cpu)
 }
 
 /// Times `clean` on the raw input and `MeshStore::from_mesh` on its result.
@@ -442,6 +448,8 @@ fn run() -> Result<(), String> {
             .flat_map(|p| p.map(|c| c as f32))
             .collect();
         let indices: Vec<u32> = welded.triangles.iter().flatten().copied().collect();
+        let bytes = meshopt::typed_to_bytes(&positions);
+        let adapter = meshopt::VertexDataAdapter::new(bytes, 12, 0).map_err(|e| e.to_string())?;
         let n = welded.triangle_count();
         eprintln!(
             "{input}: {n} triangles, {} vertices after welding; loaded in {:.2} s",
@@ -450,16 +458,19 @@ fn run() -> Result<(), String> {
         );
         for &ratio in &args.ratios {
             let target = (ratio * n as f64).floor() as usize;
-            let qem = if args.tools.qem() {
-                Some(run_qem(&welded, target, args.runs, &args)?)
-            } else {
-                None
-            };
-            let meshopt = if args.tools.meshopt() {
-                Some(run_meshopt(&positions, &indices, target, args.runs)?)
-            } else {
-                None
-            };
+            // The tools take turns, run by run, so that a drift in the machine's speed
+            // (this one's wanders by 10% over minutes) falls on both.
+            let options = qem_options(&args, target);
+            let (mut qem, mut meshopt) = (Samples::default(), Samples::default());
+            for run in 0..args.runs {
+                if args.tools.qem() {
+                    qem.push(qem_once(&welded, &options, run)?);
+                }
+                if args.tools.meshopt() {
+                    meshopt.push(meshopt_once(&adapter, &indices, target));
+                }
+            }
+            let (qem, meshopt) = (qem.measured(), meshopt.measured());
             let qem_name = match (args.fast, args.orientation_check, args.exact) {
                 (false, ..) => "qem",
                 (true, false, false) => "qem --fast",
