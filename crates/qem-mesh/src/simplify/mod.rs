@@ -23,6 +23,7 @@ mod checks;
 mod engine;
 mod exact;
 mod locality;
+mod nth_key;
 mod observer;
 mod options;
 mod orientation;

@@ -57,6 +57,7 @@
 use super::checks::Rejection;
 use super::engine::{place_merged, Counters, Settings};
 use super::locality::{in_locality_order, in_original_order, Renumbered};
+use super::nth_key::nth_key;
 use super::observer::{Contraction, Observer, Progress};
 use super::options::QuadricMode;
 use super::options::{BoundaryMode, SimplifyOptions};
@@ -893,22 +894,17 @@ impl PassEngine {
             batch.extend(0..candidates.len() as u32);
             return;
         }
-        // The batch's largest key, the `take`-th cheapest (see `cheaper`), selected
-        // among copies of the keys (not through the indices: a third of the work).
-        self.keys.clear();
-        self.keys
-            .extend(candidates.iter().zip(0u32..).map(|(c, i)| (c.cost, i)));
+        // The batch's largest key, the `take`-th cheapest (see `cheaper`).
         let by_key = |x: &(f64, u32), y: &(f64, u32)| by_cost(*x, *y);
-        let (_, &mut bound, _) = self.keys.select_nth_unstable_by(take - 1, by_key);
-        // (A cost at or below 0 only gains its ties at the bound.)
+        let key = |i: usize| (candidates[i].cost, i as u32);
+        let bound = nth_key(candidates.len(), take - 1, key, by_key, &mut self.keys);
+        // (A cost at or below 0 only gains its ties at the bound.) On both cores; the
+        // batch keeps the list's order.
         let within = bound.0 * BATCH_COST_FACTOR;
-        batch.extend(
-            candidates
-                .iter()
-                .zip(0u32..)
-                .filter(|&(c, i)| c.cost <= within || by_key(&(c.cost, i), &bound).is_le())
-                .map(|(_, i)| i),
-        );
+        batch.par_extend((0..candidates.len() as u32).into_par_iter().filter(|&i| {
+            let cost = candidates[i as usize].cost;
+            cost <= within || by_key(&(cost, i), &bound).is_le()
+        }));
     }
 
     /// The edges of `batch` that are the cheapest of `batch` at both of their ends,
