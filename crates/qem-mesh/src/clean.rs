@@ -205,30 +205,39 @@ pub fn clean(mesh: &IndexedMesh, options: &CleanOptions) -> Cleaned {
 
     let frame = Frame::from_points(mesh.positions.iter().map(|p| DVec3::from_array(*p)));
     let min_double_area = min_double_area(frame.normalized_diagonal());
-    // Each face's fate is decided independently (in parallel), then the faces are
-    // kept and counted in input order, so the result does not depend on the threads.
-    let fates: Vec<FaceFate> = mesh
+    // Each face's fate is decided independently (in parallel): a kept face gets its
+    // welded corners, a dropped one a marker that says why. Then the dropped ones are
+    // counted and taken out in input order, so the result does not depend on the
+    // threads. (Markers rather than a list of fates: one array of faces, written once.)
+    let mut faces: Vec<[u32; 3]> = mesh
         .triangles
         .par_iter()
         .map(|t| {
-            face_fate(
+            match face_fate(
                 t,
                 &mesh.positions,
                 &representative,
                 &frame,
                 min_double_area,
                 options,
-            )
+            ) {
+                FaceFate::Keep(f) => f,
+                FaceFate::RepeatedIndex => DROPPED_REPEATED_INDEX,
+                FaceFate::ZeroArea => DROPPED_ZERO_AREA,
+            }
         })
         .collect();
-    let mut faces: Vec<[u32; 3]> = Vec::with_capacity(mesh.triangles.len());
-    for fate in fates {
-        match fate {
-            FaceFate::Keep(f) => faces.push(f),
-            FaceFate::RepeatedIndex => report.repeated_index_faces += 1,
-            FaceFate::ZeroArea => report.zero_area_faces += 1,
+    faces.retain(|f| match *f {
+        DROPPED_REPEATED_INDEX => {
+            report.repeated_index_faces += 1;
+            false
         }
-    }
+        DROPPED_ZERO_AREA => {
+            report.zero_area_faces += 1;
+            false
+        }
+        _ => true,
+    });
     if options.drop_duplicates {
         report.duplicate_faces = drop_duplicate_faces(&mut faces, n);
     }
@@ -267,6 +276,13 @@ pub fn clean(mesh: &IndexedMesh, options: &CleanOptions) -> Cleaned {
         vertex_map,
     }
 }
+
+/// A dropped face's place in `clean`'s list of faces, before it is taken out. No kept
+/// face looks like it: that would take a vertex numbered `u32::MAX`, and a mesh that
+/// passed [`IndexedMesh::validate`] has at most [`crate::MAX_ELEMENTS`] vertices.
+const DROPPED_REPEATED_INDEX: [u32; 3] = [u32::MAX, u32::MAX, 0];
+/// See [`DROPPED_REPEATED_INDEX`].
+const DROPPED_ZERO_AREA: [u32; 3] = [u32::MAX, u32::MAX, 1];
 
 /// What happens to one input face.
 enum FaceFate {
