@@ -8,10 +8,10 @@
 //!    not move in the last pass keeps its cost);
 //! 3. makes a batch of the cheapest edges, as many as the contractions still needed,
 //!    by cost, ties broken by a scatter of the index in the list (a total order; see
-//!    [`scatter`] for why not the index itself), and every other edge whose cost is
-//!    within [`BATCH_COST_FACTOR`] of the last of those (many of the batch's edges
-//!    go stale as their neighbours move, so a batch of exactly the needed size falls
-//!    well short of it);
+//!    [`scatter`] for why not the index itself), and without the orientation check
+//!    every other edge whose cost is within [`BATCH_COST_FACTOR`] of the last of
+//!    those (many of the batch's edges go stale as their neighbours move, so a batch
+//!    of exactly the needed size falls well short of it);
 //! 4. contracts in rounds: each round takes the batch's *local minima*, the edges
 //!    that are the batch's cheapest at both of their ends (so no two share a vertex),
 //!    in list order (by first vertex, so the arrays are walked in order; the cheapest
@@ -84,8 +84,9 @@ const SPECULATION_CHUNK: usize = 512;
 /// Pairs per piece of work handed to another core by [`PassEngine::speculate`].
 const SPECULATION_MIN_LEN: usize = 16;
 
-/// A pass's batch also takes every edge whose cost is within this factor of the cost
-/// of the last edge it needs (see [`PassEngine::list_batch`]).
+/// Without the orientation check, a pass's batch also takes every edge whose cost is
+/// within this factor of the cost of the last edge it needs (see
+/// [`PassEngine::list_batch`]).
 ///
 /// meshoptimizer's simplifier bounds each pass's errors the same way and with the same
 /// factor (`kPassErrorBound = 1.5` in its `simplifier.cpp`, applied to the error of the
@@ -96,6 +97,14 @@ const SPECULATION_MIN_LEN: usize = 16;
 /// distance 1.022x (geometric means); with exact quadrics and the orientation check,
 /// 1.004x and 1.001x. A factor of 2 was barely faster (721 ms) and the mean distance
 /// 1.034x.
+///
+/// Why not with the orientation check: there the peers' harness counted faces facing
+/// away at ratio 0.1 on one of issue 5's 9 clean scans (cgal_mannequin_devil, 0.19%;
+/// none without the factor) and the Hausdorff distance at most the best peer's in 16
+/// of 27 cases instead of 17 (BENCHMARKS.md, "The batch's cost bound"). What that
+/// costs: the dragon's contraction phase with every default quality option in passes
+/// took 1,696 and 1,840 ms without the factor, 1,484 and 1,756 ms with it (medians of
+/// 5, alternating); the check's promise is worth more.
 pub(super) const BATCH_COST_FACTOR: f64 = 1.5;
 
 /// How often (in attempted contractions) the observer's progress is called.
@@ -885,8 +894,8 @@ impl PassEngine {
     }
 
     /// The indices of this pass's batch into `batch`, in listing order: the `take`
-    /// cheapest edges, and every edge whose cost is within [`BATCH_COST_FACTOR`] of the
-    /// `take`-th cheapest's.
+    /// cheapest edges, and without the orientation check every edge whose cost is
+    /// within [`BATCH_COST_FACTOR`] of the `take`-th cheapest's.
     fn list_batch(&mut self, take: usize, batch: &mut Vec<u32>) {
         let candidates = &self.candidates;
         batch.clear();
@@ -900,7 +909,11 @@ impl PassEngine {
         let bound = nth_key(candidates.len(), take - 1, key, by_key, &mut self.keys);
         // (A cost at or below 0 only gains its ties at the bound.) On both cores; the
         // batch keeps the list's order.
-        let within = bound.0 * BATCH_COST_FACTOR;
+        let within = if self.input_surface.is_some() {
+            f64::NEG_INFINITY
+        } else {
+            bound.0 * BATCH_COST_FACTOR
+        };
         batch.par_extend((0..candidates.len() as u32).into_par_iter().filter(|&i| {
             let cost = candidates[i as usize].cost;
             cost <= within || by_key(&(cost, i), &bound).is_le()
