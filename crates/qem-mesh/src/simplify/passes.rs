@@ -101,7 +101,7 @@ const SPECULATION_MIN_LEN: usize = 16;
 /// Why not with the orientation check: there the peers' harness counted faces facing
 /// away at ratio 0.1 on one of issue 5's 9 clean scans (cgal_mannequin_devil, 0.19%;
 /// none without the factor) and the Hausdorff distance at most the best peer's in 16
-/// of 27 cases instead of 17 (BENCHMARKS.md, "The batch's cost bound"). What that
+/// of 27 cases (18 without it; BENCHMARKS.md, "The batch's cost bound"). What that
 /// costs: the dragon's contraction phase with every default quality option in passes
 /// took 1,696 and 1,840 ms without the factor, 1,484 and 1,756 ms with it (medians of
 /// 5, alternating); the check's promise is worth more.
