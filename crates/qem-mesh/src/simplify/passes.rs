@@ -254,6 +254,24 @@ macro_rules! fixed_of {
     };
 }
 
+/// The whole mesh of the engine `$engine` as one [`Slab`], with the orientation
+/// check's hints `$hints`. A macro for the same reason as [`fixed_of`]: the slab's
+/// mutable borrows sit beside the [`Fixed`]'s shared ones.
+macro_rules! whole_slab_of {
+    ($engine:expr, $hints:expr) => {
+        Slab {
+            first_vertex: 0,
+            first_triangle: 0,
+            position: &mut $engine.position,
+            world: &mut $engine.world,
+            quadric: &mut $engine.quadric,
+            moved_in: &mut $engine.moved_in,
+            triangles: &mut $engine.triangles,
+            hints: $hints,
+        }
+    };
+}
+
 impl PassEngine {
     /// Face quadrics summed into vertex quadrics, border planes or locks, locked
     /// vertices; `locked` lists cleaned-mesh indices.
@@ -376,16 +394,7 @@ impl PassEngine {
     /// The whole mesh as one [`Slab`] (for the sequential attempts), and what does not
     /// change.
     fn split(&mut self) -> (Slab<'_>, Fixed<'_>) {
-        let slab = Slab {
-            first_vertex: 0,
-            first_triangle: 0,
-            position: &mut self.position,
-            world: &mut self.world,
-            quadric: &mut self.quadric,
-            moved_in: &mut self.moved_in,
-            triangles: &mut self.triangles,
-            hints: &mut [],
-        };
+        let slab = whole_slab_of!(self, &mut []);
         let fixed = fixed_of!(self, None);
         (slab, fixed)
     }
@@ -439,16 +448,7 @@ impl PassEngine {
             None => (None, &mut [][..]),
         };
         let fixed = fixed_of!(self, nearest);
-        let whole = Slab {
-            first_vertex: 0,
-            first_triangle: 0,
-            position: &mut self.position,
-            world: &mut self.world,
-            quadric: &mut self.quadric,
-            moved_in: &mut self.moved_in,
-            triangles: &mut self.triangles,
-            hints,
-        };
+        let whole = whole_slab_of!(self, hints);
         let (candidates, block_triangles) = (&self.candidates, &self.block_triangles);
         let mut slabs: Vec<Option<Slab>> = whole
             .into_blocks(block_vertices, block_triangles)
