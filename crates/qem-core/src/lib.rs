@@ -31,6 +31,7 @@ pub use glam::DVec3;
 pub use plane::WeightedPlane;
 pub use quadric::{unit_normal_and_area, Quadric};
 pub use solve::{
-    endpoint_placement, minimize, optimal_placement, segment_placement, solve_first_placement,
-    Placement, PlacementRule, FLAT_SEGMENT_RATIO, SINGULAR_PIVOT_RATIO,
+    endpoint_placement, minimize, minimize_by_cofactors, optimal_placement, segment_placement,
+    solve_first_placement, Placement, PlacementRule, FLAT_SEGMENT_RATIO,
+    SINGULAR_DETERMINANT_RATIO, SINGULAR_PIVOT_RATIO,
 };

@@ -2,8 +2,8 @@
 
 use approx::assert_relative_eq;
 use qem_core::{
-    endpoint_placement, minimize, optimal_placement, segment_placement, solve_first_placement,
-    DVec3, Frame, PlacementRule, Quadric,
+    endpoint_placement, minimize, minimize_by_cofactors, optimal_placement, segment_placement,
+    solve_first_placement, DVec3, Frame, PlacementRule, Quadric, SINGULAR_DETERMINANT_RATIO,
 };
 
 #[test]
@@ -48,6 +48,33 @@ fn coplanar_faces_fall_back_to_the_segment() {
     assert_eq!(p.rule, PlacementRule::Segment);
     assert_relative_eq!(p.position.x, 0.3, epsilon = 1e-12);
     assert_relative_eq!(p.cost, 0.0, epsilon = 1e-15);
+}
+
+#[test]
+fn cofactors_refuse_a_nearly_singular_matrix_at_the_ratio() {
+    // A = diag(1, 1, s): the scaled determinant is s. Just above the ratio the solve
+    // goes through, just below it is refused; the elimination accepts both (its test
+    // asks each pivot for 1e-8, and s is the only small one).
+    let at = |s: f64| {
+        Quadric::from_plane(DVec3::X, -1.0)
+            + Quadric::from_plane(DVec3::Y, -2.0)
+            + Quadric::from_plane(DVec3::Z, -3.0) * s
+    };
+    let above = at(SINGULAR_DETERMINANT_RATIO * 2.0);
+    let x = minimize_by_cofactors(&above).expect("above the ratio");
+    assert_relative_eq!(x.z, 3.0, epsilon = 1e-6);
+    assert_eq!(
+        minimize_by_cofactors(&at(SINGULAR_DETERMINANT_RATIO * 0.5)),
+        None
+    );
+    // Two small eigenvalues (a nearly flat patch): each 1e-5, the product 1e-10. The
+    // elimination solves it; the cofactors send it to the segment rule.
+    let flat = Quadric::from_plane(DVec3::X, -1.0)
+        + Quadric::from_plane(DVec3::Y, -2.0) * 1e-5
+        + Quadric::from_plane(DVec3::Z, -3.0) * 1e-5;
+    assert!(minimize(&flat).is_some());
+    assert_eq!(minimize_by_cofactors(&flat), None);
+    assert_eq!(minimize_by_cofactors(&Quadric::ZERO), None);
 }
 
 #[test]

@@ -1,7 +1,9 @@
 //! Property tests of the quadric algebra and of placement.
 
 use proptest::prelude::*;
-use qem_core::{minimize, optimal_placement, DVec3, Quadric};
+use qem_core::{
+    minimize, minimize_by_cofactors, optimal_placement, solve_first_placement, DVec3, Quadric,
+};
 
 /// A plane with unit normal, offset and weight, kept explicitly for brute force.
 #[derive(Clone, Copy, Debug)]
@@ -131,6 +133,48 @@ proptest! {
                 prop_assert!(q.evaluate(x - 1e-3 * dir) >= here - rounding(scale));
             }
         }
+    }
+
+    /// The solve by cofactors finds the same minimum as the elimination wherever it
+    /// finds one, and where the elimination finds none (a singular `A`), it finds none
+    /// either: for a sum of planes its test is the stricter of the two (the scaled
+    /// determinant is the product of two pivot ratios, each at most 1).
+    #[test]
+    fn cofactors_agree_with_elimination(ps in prop::collection::vec(plane(), 1..12)) {
+        let q = sum(&ps);
+        match (minimize_by_cofactors(&q), minimize(&q)) {
+            (Some(x), Some(y)) => {
+                let scale = 1.0 + y.length();
+                prop_assert!((x - y).length() <= 1e-6 * scale, "cofactors {x}, elimination {y}");
+                let g = q.gradient(x);
+                prop_assert!(g.length() <= 1e-6 * q.magnitude() * scale, "gradient {g} at {x}");
+            }
+            (Some(x), None) => prop_assert!(false, "cofactors found {x} where elimination found none"),
+            (None, _) => {}
+        }
+    }
+
+    /// The test is scale-free: the quadric times any power of two (exact, so the
+    /// scaled entries are the same bits) gives the same verdict and the same point.
+    #[test]
+    fn cofactors_are_scale_free(ps in planes(), k in -900..900i32) {
+        let q = sum(&ps);
+        let factor = 2f64.powi(k);
+        let scaled = Quadric::from_entries(q.entries().map(|e| e * factor));
+        prop_assume!(scaled.entries().iter().zip(q.entries()).all(|(s, e)| *s / factor == e));
+        prop_assert_eq!(minimize_by_cofactors(&scaled), minimize_by_cofactors(&q));
+    }
+
+    #[test]
+    fn any_entries_give_a_finite_point_or_none(
+        e in prop::array::uniform10(any_entry()), a in point(), b in point()
+    ) {
+        let q = Quadric::from_entries(e);
+        if let Some(x) = minimize_by_cofactors(&q) {
+            prop_assert!(x.is_finite());
+        }
+        let placed = solve_first_placement(&q, a, b);
+        prop_assert!(placed.position.is_finite());
     }
 
     #[test]

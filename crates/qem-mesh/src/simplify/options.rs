@@ -50,8 +50,9 @@ pub enum PlacementMode {
     /// Garland–Heckbert's rule as published: the quadric's minimum whenever the 3x3
     /// solve succeeds, without comparing it with the segment and the ends (which
     /// [`Optimal`](Self::Optimal) does, to guard against rounding in nearly singular
-    /// solves); the fallback chain only when the solve fails. About half the work per
-    /// pair. Used by [`SimplifyOptions::FAST`].
+    /// solves); the fallback chain only when the solve fails. The solve is by
+    /// cofactors ([`qem_core::minimize_by_cofactors`]) rather than by elimination:
+    /// about a fifth of the work per pair. Used by [`SimplifyOptions::FAST`].
     SolveFirst,
 }
 
