@@ -192,6 +192,9 @@ pub(super) struct PassEngine {
     /// The last pass's edges and costs in listing order, and where each vertex's start.
     last_listed: Vec<Candidate>,
     last_listed_first: Vec<u32>,
+    /// The candidates whose cost this pass ranks at the waivers' penalty, with their
+    /// costs before it (restored before the list becomes `last_listed`).
+    penalised: Vec<(u32, f64)>,
     /// Per vertex, the last vertex whose edges were listed with it (edge listing).
     seen_with: Vec<u32>,
     around: [Vec<Around>; 2],
@@ -330,6 +333,7 @@ impl PassEngine {
             listed_first: Vec::new(),
             last_listed: Vec::new(),
             last_listed_first: Vec::new(),
+            penalised: Vec::new(),
             seen_with: vec![u32::MAX; n],
             around: [Vec::new(), Vec::new()],
             chunk: 0,
@@ -542,9 +546,10 @@ impl PassEngine {
         // a triangle that is not live keeps a zero normal (never read) and no plane.
         // Planes rather than quadrics kept (40 bytes a triangle instead of 80, at the
         // setup's memory peak); with exact quadrics the planes are kept for the run.
+        // Both arrays are written once, by the threads that compute them: filled
+        // arrays made first were 64 bytes a triangle of pages faulted in and zeroed on
+        // one core (14% of the sphere:4M run's page faults), then written again.
         let count = self.triangles.len();
-        let mut normals = vec![DVec3::ZERO; count];
-        let mut planes = vec![WeightedPlane::NONE; count];
         let is_live = (self.live.len() < count).then(|| {
             let mut is_live = vec![false; count];
             for &t in &self.live {
@@ -553,19 +558,21 @@ impl PassEngine {
             is_live
         });
         let (position, triangles) = (&self.position, &self.triangles);
-        normals
-            .par_iter_mut()
-            .zip(planes.par_iter_mut())
-            .enumerate()
-            .filter(|(t, _)| is_live.as_ref().is_none_or(|live| live[*t]))
-            .for_each(|(t, (normal, plane))| {
+        let (mut normals, mut planes) = (Vec::new(), Vec::new());
+        (0..count)
+            .into_par_iter()
+            .map(|t| {
+                if is_live.as_ref().is_some_and(|live| !live[t]) {
+                    return (DVec3::ZERO, WeightedPlane::NONE);
+                }
                 let [pa, pb, pc] = triangles[t].map(|c| position[c as usize]);
-                *plane = match area_offset {
+                let plane = match area_offset {
                     Some(extra) => WeightedPlane::from_triangle_area_plus(pa, pb, pc, extra),
                     None => WeightedPlane::from_triangle_unweighted(pa, pb, pc),
                 };
-                *normal = (pb - pa).cross(pc - pa);
-            });
+                ((pb - pa).cross(pc - pa), plane)
+            })
+            .unzip_into_vecs(&mut normals, &mut planes);
         // Each vertex's quadric, summed over its live triangles in the order of
         // `live` (the order of its incident list): the bits the sum in that order gives,
         // whatever the thread count. (Made from the plane at each corner rather than
@@ -949,8 +956,16 @@ impl PassEngine {
     }
 
     /// Lists every edge of the live triangles once, as (smaller end, larger end), in
-    /// order of the smaller end.
+    /// order of the smaller end. The last pass's list, with its costs as computed
+    /// (unpenalised), becomes `last_listed`, and the list before it is overwritten.
     fn list_edges(&mut self) {
+        // Handed over rather than copied at costing time: the copy was 16 bytes an edge
+        // a pass, the first pass's onto fresh pages.
+        for (i, cost) in self.penalised.drain(..) {
+            self.candidates[i as usize].cost = cost;
+        }
+        std::mem::swap(&mut self.candidates, &mut self.last_listed);
+        std::mem::swap(&mut self.listed_first, &mut self.last_listed_first);
         self.seen_with.fill(u32::MAX);
         self.candidates.clear();
         self.listed_first.clear();
@@ -1000,9 +1015,6 @@ impl PassEngine {
             };
         });
         self.candidates = candidates;
-        // The unpenalised costs are the ones a later pass may reuse.
-        self.last_listed.clone_from(&self.candidates);
-        std::mem::swap(&mut self.last_listed_first, &mut self.listed_first);
         // Waived pairs are ranked at the greedy loop's penalty on their merged quadric.
         // (Few: a pass lists them first, then reads their quadrics.)
         if self.waivers.is_empty() {
@@ -1014,8 +1026,10 @@ impl PassEngine {
                 self.waivers.contains(c.a, c.b)
             })
             .collect();
+        // The unpenalised costs are the ones a later pass may reuse: kept aside.
         for i in waived {
             let Candidate { a, b, cost } = self.candidates[i];
+            self.penalised.push((i as u32, cost));
             self.candidates[i].cost = penalised(cost, &self.merged_quadric(a, b));
         }
     }
