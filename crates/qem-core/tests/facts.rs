@@ -53,8 +53,8 @@ fn coplanar_faces_fall_back_to_the_segment() {
 #[test]
 fn cofactors_refuse_a_nearly_singular_matrix_at_the_ratio() {
     // A = diag(1, 1, s): the scaled determinant is s. Just above the ratio the solve
-    // goes through, just below it is refused; the elimination accepts both (its test
-    // asks each pivot for 1e-8, and s is the only small one).
+    // goes through, just below it is refused. (For this matrix the elimination's test
+    // asks the same of s: its last pivot ratio is s too.)
     let at = |s: f64| {
         Quadric::from_plane(DVec3::X, -1.0)
             + Quadric::from_plane(DVec3::Y, -2.0)
@@ -67,8 +67,9 @@ fn cofactors_refuse_a_nearly_singular_matrix_at_the_ratio() {
         minimize_by_cofactors(&at(SINGULAR_DETERMINANT_RATIO * 0.5)),
         None
     );
-    // Two small eigenvalues (a nearly flat patch): each 1e-5, the product 1e-10. The
-    // elimination solves it; the cofactors send it to the segment rule.
+    // Two small eigenvalues (a nearly flat patch): each 1e-5, the product 1e-10. Here
+    // the two tests differ: the elimination solves it (each pivot ratio is 1e-5); the
+    // cofactors send it to the segment rule.
     let flat = Quadric::from_plane(DVec3::X, -1.0)
         + Quadric::from_plane(DVec3::Y, -2.0) * 1e-5
         + Quadric::from_plane(DVec3::Z, -3.0) * 1e-5;

@@ -51,8 +51,9 @@ pub enum PlacementMode {
     /// solve succeeds, without comparing it with the segment and the ends (which
     /// [`Optimal`](Self::Optimal) does, to guard against rounding in nearly singular
     /// solves); the fallback chain only when the solve fails. The solve is by
-    /// cofactors ([`qem_core::minimize_by_cofactors`]) rather than by elimination:
-    /// about a fifth of the work per pair. Used by [`SimplifyOptions::FAST`].
+    /// cofactors ([`qem_core::minimize_by_cofactors`], about a fifth of the time of
+    /// the elimination [`Optimal`](Self::Optimal) uses). Used by
+    /// [`SimplifyOptions::FAST`].
     SolveFirst,
 }
 

@@ -194,7 +194,7 @@ pub(super) struct PassEngine {
     last_listed_first: Vec<u32>,
     /// The candidates whose cost this pass ranks at the waivers' penalty, with their
     /// costs before it (restored before the list becomes `last_listed`).
-    penalised: Vec<(u32, f64)>,
+    unpenalised_costs: Vec<(u32, f64)>,
     /// Per vertex, the last vertex whose edges were listed with it (edge listing).
     seen_with: Vec<u32>,
     around: [Vec<Around>; 2],
@@ -333,7 +333,7 @@ impl PassEngine {
             listed_first: Vec::new(),
             last_listed: Vec::new(),
             last_listed_first: Vec::new(),
-            penalised: Vec::new(),
+            unpenalised_costs: Vec::new(),
             seen_with: vec![u32::MAX; n],
             around: [Vec::new(), Vec::new()],
             chunk: 0,
@@ -961,7 +961,7 @@ impl PassEngine {
     fn list_edges(&mut self) {
         // Handed over rather than copied at costing time: the copy was 16 bytes an edge
         // a pass, the first pass's onto fresh pages.
-        for (i, cost) in self.penalised.drain(..) {
+        for (i, cost) in self.unpenalised_costs.drain(..) {
             self.candidates[i as usize].cost = cost;
         }
         std::mem::swap(&mut self.candidates, &mut self.last_listed);
@@ -1029,7 +1029,7 @@ impl PassEngine {
         // The unpenalised costs are the ones a later pass may reuse: kept aside.
         for i in waived {
             let Candidate { a, b, cost } = self.candidates[i];
-            self.penalised.push((i as u32, cost));
+            self.unpenalised_costs.push((i as u32, cost));
             self.candidates[i].cost = penalised(cost, &self.merged_quadric(a, b));
         }
     }
