@@ -839,11 +839,18 @@ fn wide_node_count(n: usize) -> usize {
     }
 }
 
-/// Sets the boxes of each child of each node, bottom-up (a child node always comes
-/// after its parent, see [`wide_nodes`]): the box of its corners and the box of its
-/// unit normals, both rounded outward to `f32`. A triangle whose normal is shorter
+/// Sets the boxes of each child of each node: the box of its corners and the box of
+/// its unit normals, both rounded outward to `f32`. A triangle whose normal is shorter
 /// than [`MIN_PRUNING_LENGTH`] (but not zero), infinite or NaN counts as facing every
 /// way; a zero-area one has no direction and no say.
+///
+/// Two sweeps: the leaf children first, node by node on both cores (each reads only
+/// its own entries: the triangles' normals, a square root and three divisions each,
+/// were most of the time, on one core while the other had finished its share of the
+/// setup), then the inner children bottom-up on one core (a child node always comes
+/// after its parent, see [`wide_nodes`]; each is a union of at most four lanes). Each
+/// box is made by the same operations in the same order either way, so the tree is
+/// the same, bit for bit, with any number of threads.
 ///
 /// An inner child's position box is the union of its node's lanes: the same bits as
 /// rounding the `f64` box of all its corners, up to the sign of a zero bound, since
@@ -854,38 +861,46 @@ fn wide_node_count(n: usize) -> usize {
 ///
 /// `entry(e)` gives leaf entry `e`'s triangle and its box (the triangle's, or its
 /// piece's).
-fn fill_boxes(nodes: &mut [WideNode], entry: impl Fn(usize) -> ([P3; 3], (P3, P3))) {
+fn fill_boxes(nodes: &mut [WideNode], entry: impl Fn(usize) -> ([P3; 3], (P3, P3)) + Sync) {
+    nodes.par_iter_mut().for_each(|node| {
+        for i in 0..usize::from(node.lanes) {
+            let count = usize::from(node.leaf_count[i]);
+            if count == 0 {
+                continue;
+            }
+            let first = node.child[i] as usize;
+            let mut normals = Box32::EMPTY;
+            let mut bounds = Aabb::EMPTY;
+            for e in first..first + count {
+                let ([a, b, c], (lo, hi)) = entry(e);
+                bounds.add(&Aabb { lo, hi });
+                let normal = cross(sub(b, a), sub(c, a));
+                let length = length(normal);
+                if length >= MIN_PRUNING_LENGTH && length.is_finite() {
+                    let unit = normal.map(|x| x / length);
+                    normals.grow(&Box32::around(unit, unit));
+                } else if normal != [0.0; 3] {
+                    normals.grow(&Box32::around([-1.0; 3], [1.0; 3]));
+                }
+            }
+            node.set_child(i, &Box32::around(bounds.lo, bounds.hi), &normals);
+        }
+    });
     for w in (0..nodes.len()).rev() {
         for i in 0..usize::from(nodes[w].lanes) {
+            if nodes[w].leaf_count[i] > 0 {
+                continue;
+            }
             let mut position = Box32::EMPTY;
             let mut normals = Box32::EMPTY;
-            let count = usize::from(nodes[w].leaf_count[i]);
-            let first = nodes[w].child[i] as usize;
-            if count > 0 {
-                let mut bounds = Aabb::EMPTY;
-                for e in first..first + count {
-                    let ([a, b, c], (lo, hi)) = entry(e);
-                    bounds.add(&Aabb { lo, hi });
-                    let normal = cross(sub(b, a), sub(c, a));
-                    let length = length(normal);
-                    if length >= MIN_PRUNING_LENGTH && length.is_finite() {
-                        let unit = normal.map(|x| x / length);
-                        normals.grow(&Box32::around(unit, unit));
-                    } else if normal != [0.0; 3] {
-                        normals.grow(&Box32::around([-1.0; 3], [1.0; 3]));
-                    }
-                }
-                position = Box32::around(bounds.lo, bounds.hi);
-            } else {
-                let child = &nodes[first];
-                for j in 0..usize::from(child.lanes) {
-                    let lane = |lo: &[[f32; WIDTH]; 3], hi: &[[f32; WIDTH]; 3]| Box32 {
-                        lo: [0, 1, 2].map(|k| lo[k][j]),
-                        hi: [0, 1, 2].map(|k| hi[k][j]),
-                    };
-                    position.grow(&lane(&child.lo, &child.hi));
-                    normals.grow(&lane(&child.normal_lo, &child.normal_hi));
-                }
+            let child = &nodes[nodes[w].child[i] as usize];
+            for j in 0..usize::from(child.lanes) {
+                let lane = |lo: &[[f32; WIDTH]; 3], hi: &[[f32; WIDTH]; 3]| Box32 {
+                    lo: [0, 1, 2].map(|k| lo[k][j]),
+                    hi: [0, 1, 2].map(|k| hi[k][j]),
+                };
+                position.grow(&lane(&child.lo, &child.hi));
+                normals.grow(&lane(&child.normal_lo, &child.normal_hi));
             }
             nodes[w].set_child(i, &position, &normals);
         }
