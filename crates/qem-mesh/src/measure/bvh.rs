@@ -1039,6 +1039,36 @@ mod tests {
         corners
     }
 
+    /// Every box is the same bits with one thread and with three (`fill_boxes` fills
+    /// the leaf lanes on the thread pool, then the inner ones in order), with and
+    /// without pieces.
+    #[test]
+    fn boxes_do_not_depend_on_the_thread_count() {
+        // The boxes' bits, and whether the tree has pieces.
+        let bits = |corners: &Vec<[P3; 3]>, threads: usize| -> (Vec<u32>, bool) {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("a thread pool");
+            let (tree, _) = pool.install(|| TriangleBvh::from_corners(corners.clone()));
+            let bits = (tree.nodes.iter())
+                .flat_map(|n| [n.lo, n.hi, n.normal_lo, n.normal_hi])
+                .flatten()
+                .flatten()
+                .map(f32::to_bits)
+                .collect();
+            (bits, tree.pieces.is_some())
+        };
+        let with_pieces = fan_over_grid();
+        let grid = with_pieces[..1800].to_vec();
+        for (corners, pieces) in [(grid, false), (with_pieces, true)] {
+            let one = bits(&corners, 1);
+            assert!(one.0.len() > 1000, "a tree of many nodes");
+            assert_eq!(one.1, pieces);
+            assert_eq!(one, bits(&corners, 3));
+        }
+    }
+
     /// With pieces, every triangle is found through its pieces: each point of a
     /// triangle lies in the box of a leaf child that holds one of its pieces, and the
     /// numbering still maps every input triangle to its corners.
