@@ -2,11 +2,10 @@
 
 use super::bytes::Bytes;
 use crate::mesh_checks::assert_valid_output;
-use qem_core::{DVec3, Frame};
 use qem_mesh::clean::{clean, CleanOptions};
 use qem_mesh::simplify::{
-    simplify, ContractionOrder, Length, PlacementMode, QuadricMode, SimplifyError, SimplifyOptions,
-    StopReason, Target, Weighting,
+    simplify, simplify_observed, ContractionOrder, Length, PlacementMode, QuadricMode,
+    SimplifyError, SimplifyOptions, StopReason, StoreReplay, Target, Weighting,
 };
 use qem_mesh::IndexedMesh;
 
@@ -21,27 +20,18 @@ const OFFSETS: [f64; 4] = [0.0, 1.0, 1e6, -1e12];
 /// At most this many faces, so one run stays in the millisecond range.
 const MAX_FACES: usize = 48;
 
-/// In [`ContractionOrder::Passes`], the one option of those it lacks that the input
-/// asks for anyway (to check the refusal), with the name
-/// [`SimplifyError::NotInPasses`] must give.
+/// In [`ContractionOrder::Passes`], one more option that [`SimplifyOptions::FAST`]
+/// leaves off: topology preservation, or virtual pairs (the pass-based order once
+/// refused both, so the seeds that ask for them are named `_refuses_`).
 #[derive(Clone, Copy, Debug, PartialEq)]
-enum Lacking {
+enum PassesExtra {
     PreserveTopology,
     PairThreshold,
 }
 
-impl Lacking {
-    fn name(self) -> &'static str {
-        match self {
-            Lacking::PreserveTopology => "preserve_topology = true",
-            Lacking::PairThreshold => "pair_threshold above zero (virtual pairs)",
-        }
-    }
-}
-
 /// A soup of up to 16 vertices on a 5×5×5 grid (scaled and offset) and up to 48 faces,
-/// with options, from fuzz bytes; and, in the pass-based order, the lacking option
-/// asked for, if any.
+/// with options, from fuzz bytes; and, in the pass-based order, the extra option asked
+/// for, if any.
 ///
 /// Layout: vertex count, target kind (and order) and value, option flags, pair
 /// threshold, max error, virtual-pair cap, weld tolerance, scale, offset; then three
@@ -52,10 +42,10 @@ impl Lacking {
 /// [`ContractionOrder::Passes`] (with summed quadrics, no orientation check, no
 /// virtual pairs and `SolveFirst` for the optimal placement, as in
 /// [`SimplifyOptions::FAST`]); with it, bit 7 and bits 2–3 pick one more option: exact
-/// quadrics (bits 2–3 = 0), the orientation check (1), or one that order lacks (2:
-/// topology, 3: a pair threshold). No committed seed from before the pass-based order
+/// quadrics (bits 2–3 = 0), the orientation check (1), topology preservation (2) or a
+/// pair threshold (3). No committed seed from before the pass-based order
 /// has bit 6 set, so each still decodes to the same greedy case.
-fn decode(data: &[u8]) -> (IndexedMesh, SimplifyOptions, Option<Lacking>) {
+fn decode(data: &[u8]) -> (IndexedMesh, SimplifyOptions, Option<PassesExtra>) {
     let mut b = Bytes::new(data);
     let n = 3 + b.below(14);
     let kind = b.byte();
@@ -63,12 +53,12 @@ fn decode(data: &[u8]) -> (IndexedMesh, SimplifyOptions, Option<Lacking>) {
     let asks = passes && kind & 0x80 != 0;
     let exact_quadrics = asks && (kind >> 2) & 3 == 0;
     let orientation = asks && (kind >> 2) & 3 == 1;
-    let lacking = asks.then_some(match (kind >> 2) & 3 {
+    let extra = asks.then_some(match (kind >> 2) & 3 {
         0 | 1 => None,
-        2 => Some(Lacking::PreserveTopology),
-        _ => Some(Lacking::PairThreshold),
+        2 => Some(PassesExtra::PreserveTopology),
+        _ => Some(PassesExtra::PairThreshold),
     });
-    let lacking = lacking.flatten();
+    let extra = extra.flatten();
     let target = match (kind % 4, b.byte()) {
         (0, x) => Target::Ratio(f64::from(x) / 255.0),
         (1, x) => Target::Triangles(usize::from(x)),
@@ -113,8 +103,7 @@ fn decode(data: &[u8]) -> (IndexedMesh, SimplifyOptions, Option<Lacking>) {
         .with_max_error(flag(2).then_some(length(max_error)))
         .with_pair_threshold(length(threshold))
         .with_max_virtual_pairs_per_vertex(cap)
-        .with_clean(clean_options)
-        .with_validate_each_contraction(true);
+        .with_clean(clean_options);
     if passes {
         options = options
             .with_order(ContractionOrder::Passes)
@@ -129,9 +118,9 @@ fn decode(data: &[u8]) -> (IndexedMesh, SimplifyOptions, Option<Lacking>) {
         if options.placement == PlacementMode::Optimal {
             options = options.with_placement(PlacementMode::SolveFirst);
         }
-        match lacking {
-            Some(Lacking::PreserveTopology) => options = options.with_preserve_topology(true),
-            Some(Lacking::PairThreshold) => {} // as decoded, perhaps zero
+        match extra {
+            Some(PassesExtra::PreserveTopology) => options = options.with_preserve_topology(true),
+            Some(PassesExtra::PairThreshold) => {} // as decoded, perhaps zero
             None => options = options.with_pair_threshold(Length::DiagonalFraction(0.0)),
         }
     }
@@ -143,44 +132,23 @@ fn decode(data: &[u8]) -> (IndexedMesh, SimplifyOptions, Option<Lacking>) {
     while !b.is_empty() && triangles.len() < MAX_FACES {
         triangles.push([(); 3].map(|()| b.below(n) as u32));
     }
-    (IndexedMesh::new(positions, triangles), options, lacking)
-}
-
-/// Whether `simplify` must refuse `options` in the pass-based order once `mesh` is
-/// cleaned (and has triangles left): always for the lacking option asked for, except a
-/// pair threshold that is zero in the simplifier's frame (a negative or NaN [`Length`]
-/// counts as zero, as its documentation says).
-fn must_refuse(mesh: &IndexedMesh, options: &SimplifyOptions, lacking: Lacking) -> bool {
-    if lacking != Lacking::PairThreshold {
-        return true;
-    }
-    let cleaned = clean(mesh, &options.clean).mesh;
-    let frame = Frame::from_points(cleaned.positions.iter().map(|p| DVec3::from_array(*p)));
-    let normalized = match options.pair_threshold {
-        Length::DiagonalFraction(f) => frame.diagonal_fraction_to_distance(f),
-        Length::Absolute(d) => frame.distance_to_normalized(d),
-    };
-    normalized > 0.0
+    (IndexedMesh::new(positions, triangles), options, extra)
 }
 
 /// `simplify_soup`: whatever the soup and options, `simplify` gives a valid mesh with a
-/// consistent report, or the documented error for an invalid or fully degenerate input
-/// or for an option the pass-based order lacks; in the greedy order the store's
-/// invariants hold after every contraction, in the pass-based order no output face is
-/// flipped; and a second run gives the same result bit for bit.
+/// consistent report, or the documented error for an invalid or fully degenerate input;
+/// replayed on the store ([`StoreReplay`]), every contraction keeps the store valid and
+/// the store ends as the output; in the pass-based order no output face is flipped;
+/// and a second run gives the same result bit for bit.
 pub fn simplify_soup(data: &[u8]) {
-    let (mesh, options, lacking) = decode(data);
+    let (mesh, options, _) = decode(data);
     let passes = options.order == ContractionOrder::Passes;
-    let first = simplify(&mesh, &options);
-    if let Some(lacking) = lacking {
-        let refused = matches!(first, Err(SimplifyError::NotInPasses { .. }));
-        let reached =
-            mesh.validate().is_ok() && !clean(&mesh, &options.clean).mesh.triangles.is_empty();
-        assert_eq!(
-            refused,
-            reached && must_refuse(&mesh, &options, lacking),
-            "{lacking:?}: {first:?}"
-        );
+    let mut replay = StoreReplay::default();
+    let first = simplify_observed(&mesh, &options, &mut replay);
+    if let Ok(out) = &first {
+        if let Err(e) = replay.check_output(&out.mesh) {
+            panic!("the store disagrees with the engine: {e}");
+        }
     }
     match &first {
         Err(SimplifyError::Input(e)) => {
@@ -195,13 +163,6 @@ pub fn simplify_soup(data: &[u8]) {
                     || !options.clean.drop_zero_area,
                 "refused an input with triangles left after cleaning"
             );
-        }
-        Err(SimplifyError::NotInPasses { option }) => {
-            let lacking = lacking.expect("refused only what the input asked for");
-            assert_eq!(*option, lacking.name());
-            assert!(first
-                .as_ref()
-                .is_err_and(|e| e.to_string().contains(option)));
         }
         Err(e) => panic!("unexpected error: {e}"),
         Ok(out) => {
@@ -220,7 +181,8 @@ pub fn simplify_soup(data: &[u8]) {
             if r.stop_reason == StopReason::TargetReached {
                 assert!(r.triangles_out <= r.target_triangles, "{r:?}");
             }
-            if options.pair_threshold == Length::DiagonalFraction(0.0) || passes {
+            if options.pair_threshold == Length::DiagonalFraction(0.0) || options.preserve_topology
+            {
                 assert_eq!(r.virtual_contractions, 0);
             }
             if passes {
@@ -276,13 +238,13 @@ mod tests {
     /// format stayed compatible); those named `_passes` run in passes (with the
     /// orientation check when named `_orientation_check`, with exact quadrics when
     /// named `_exact_quadrics`), and those named `_refuses_` ask for the option they
-    /// name and are refused with its name.
+    /// name (which that order once refused).
     #[test]
     fn seeds_decode_to_the_order_their_name_says() {
         let seeds = seeds();
         assert!(seeds.iter().filter(|(n, _)| n.contains("_passes")).count() >= 6);
         for (name, data) in seeds {
-            let (mesh, options, lacking) = decode(&data);
+            let (_, options, extra) = decode(&data);
             let want = if name.contains("_passes") {
                 ContractionOrder::Passes
             } else {
@@ -298,23 +260,13 @@ mod tests {
                 let exact = options.quadrics == QuadricMode::Exact;
                 assert_eq!(exact, name.contains("_exact_quadrics"), "{name}");
             }
-            // Only a seed that asks for a lacking option runs here (the replay test
-            // runs them all through the whole check).
-            let refused = match lacking.map(|_| simplify(&mesh, &options)) {
-                Some(Err(SimplifyError::NotInPasses { option })) => Some(option),
-                _ => None,
-            };
-            match name.split_once("_refuses_") {
-                Some((_, what)) => {
-                    let asked = match what {
-                        "preserve_topology" => Lacking::PreserveTopology,
-                        "pair_threshold" => Lacking::PairThreshold,
-                        _ => panic!("{name}: refuses what?"),
-                    };
-                    assert_eq!(lacking, Some(asked), "{name}");
-                    assert_eq!(refused, Some(asked.name()), "{name}");
-                }
-                None => assert_eq!(refused, None, "{name}"),
+            if let Some((_, what)) = name.split_once("_refuses_") {
+                let asked = match what {
+                    "preserve_topology" => PassesExtra::PreserveTopology,
+                    "pair_threshold" => PassesExtra::PairThreshold,
+                    _ => panic!("{name}: refuses what?"),
+                };
+                assert_eq!(extra, Some(asked), "{name}");
             }
         }
     }

@@ -5,9 +5,8 @@
 use crate::failure::Failure;
 use clap::{Args, ValueEnum};
 use qem_mesh::simplify::{
-    BoundaryMode, ContractionOrder, Length, PlacementMode, QuadricMode, SimplifyOptions, Target,
-    VirtualPairs, Weighting, DEFAULT_BOUNDARY_WEIGHT, DEFAULT_MAX_NORMAL_ANGLE,
-    DEFAULT_MIN_TRIANGLE_QUALITY,
+    BoundaryMode, Length, QuadricMode, SimplifyOptions, Target, VirtualPairs, Weighting,
+    DEFAULT_BOUNDARY_WEIGHT, DEFAULT_MAX_NORMAL_ANGLE, DEFAULT_MIN_TRIANGLE_QUALITY,
 };
 use std::path::{Path, PathBuf};
 
@@ -98,10 +97,9 @@ pub struct SimplifyFlags {
     /// Contract in passes over flat arrays instead of one pair at a time: several
     /// times faster, a little less accurate. Uses summed quadrics (unless --quadrics
     /// exact), no orientation check (unless --orientation-check), and the 3x3 solve's
-    /// point without comparing it with the segment's.
-    /// Cannot be combined with --preserve-topology, nor with a --pair-threshold above 0
-    /// (refused when the run starts) [default: off].
-    #[arg(long, conflicts_with = "preserve_topology")]
+    /// point without comparing it with the segment's. Every other option works with it
+    /// [default: off].
+    #[arg(long)]
     pub fast: bool,
     /// Quadric of a contracted pair [default: exact, or sum with --fast].
     #[arg(long, value_enum)]
@@ -225,7 +223,20 @@ impl SimplifyFlags {
             (None, Some(r)) => Target::Ratio(r),
             (None, None) => Target::Ratio(0.5),
         };
-        let options = SimplifyOptions::DEFAULT
+        // The preset first (FAST's order, quadrics, check and placement are the
+        // library's, not rebuilt here), then what the flags say.
+        let preset = if self.fast {
+            SimplifyOptions::FAST
+        } else {
+            SimplifyOptions::DEFAULT
+        };
+        let orientation_check = if self.fast {
+            self.orientation_check
+        } else {
+            !self.no_orientation_check
+        };
+        let options = preset
+            .clone()
             .with_target(target)
             .with_max_error(self.max_error.map(|e| self.length(e)))
             .with_pair_threshold(self.length(self.pair_threshold))
@@ -242,22 +253,14 @@ impl SimplifyFlags {
             })
             .with_max_normal_angle(self.max_normal_angle)
             .with_min_triangle_quality(self.min_quality)
-            .with_orientation_check(!self.no_orientation_check)
+            .with_orientation_check(orientation_check)
             .with_preserve_topology(self.preserve_topology)
-            .with_weighting(self.weighting);
-        let quadrics = match (self.quadrics, self.fast) {
-            (Some(QuadricsFlag::Sum), _) | (None, true) => QuadricMode::Sum,
-            (Some(QuadricsFlag::Exact), _) | (None, false) => QuadricMode::Exact,
-        };
-        let options = options.with_quadrics(quadrics);
-        let options = if self.fast {
-            options
-                .with_order(ContractionOrder::Passes)
-                .with_orientation_check(self.orientation_check)
-                .with_placement(PlacementMode::SolveFirst)
-        } else {
-            options
-        };
+            .with_weighting(self.weighting)
+            .with_quadrics(match self.quadrics {
+                Some(QuadricsFlag::Sum) => QuadricMode::Sum,
+                Some(QuadricsFlag::Exact) => QuadricMode::Exact,
+                None => preset.quadrics,
+            });
         Ok(match &self.lock {
             Some(path) => {
                 options.with_locked_vertices(read_lock_file(path).map_err(Failure::Failed)?)
@@ -327,7 +330,7 @@ mod tests {
     }
 
     #[test]
-    fn fast_gives_the_fast_preset_and_refuses_what_it_lacks() {
+    fn fast_gives_the_fast_preset_and_takes_every_other_option() {
         use clap::Parser;
         #[derive(Parser)]
         struct Cli {
@@ -339,11 +342,11 @@ mod tests {
             .options()
             .expect("no lock file");
         assert_eq!(options, SimplifyOptions::FAST);
-        let args = ["qem", "--fast", "--preserve-topology"];
-        assert!(
-            Cli::try_parse_from(args).is_err(),
-            "--fast with --preserve-topology"
-        );
+        let options = Cli::parse_from(["qem", "--fast", "--preserve-topology"])
+            .flags
+            .options()
+            .expect("no lock file");
+        assert_eq!(options, SimplifyOptions::FAST.with_preserve_topology(true));
         // --quadrics exact gives exact quadrics in passes; sum is FAST's own.
         for (flag, quadrics) in [("exact", QuadricMode::Exact), ("sum", QuadricMode::Sum)] {
             let options = Cli::parse_from(["qem", "--fast", "--quadrics", flag])

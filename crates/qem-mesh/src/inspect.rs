@@ -285,7 +285,7 @@ fn count_edge_groups(edges: &[[VertexKey; 2]]) -> usize {
 }
 
 /// Union–find root of `i`, halving the path on the way.
-fn find(parent: &mut [usize], mut i: usize) -> usize {
+pub(crate) fn find(parent: &mut [usize], mut i: usize) -> usize {
     while parent[i] != i {
         parent[i] = parent[parent[i]];
         i = parent[i];
@@ -294,7 +294,7 @@ fn find(parent: &mut [usize], mut i: usize) -> usize {
 }
 
 /// Joins the groups of `i` and `j`.
-fn union(parent: &mut [usize], i: usize, j: usize) {
+pub(crate) fn union(parent: &mut [usize], i: usize, j: usize) {
     let (ri, rj) = (find(parent, i), find(parent, j));
     if ri != rj {
         parent[ri.max(rj)] = ri.min(rj);

@@ -15,7 +15,6 @@ pub mod inspect;
 pub mod io;
 pub mod measure;
 pub mod pairs;
-mod queue;
 pub mod simplify;
 pub mod store;
 

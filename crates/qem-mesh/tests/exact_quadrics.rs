@@ -195,7 +195,6 @@ fn exact(target: f64) -> SimplifyOptions {
     SimplifyOptions::DEFAULT
         .with_quadrics(QuadricMode::Exact)
         .with_target(Target::Ratio(target))
-        .with_validate_each_contraction(true)
 }
 
 #[test]

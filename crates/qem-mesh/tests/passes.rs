@@ -9,7 +9,9 @@
 mod common;
 mod passes_common;
 
-use common::{assert_valid, concat, grid, jagged_sheet, torus, uv_sphere};
+use common::{
+    assert_valid, concat, grid, jagged_sheet, simplify_replayed, topology, torus, uv_sphere,
+};
 use passes_common::{
     bits, border_and_nonmanifold_edges, border_loops, border_vertices, components, noisy_sphere,
     position_bits,
@@ -17,8 +19,8 @@ use passes_common::{
 use qem_mesh::clean::CleanOptions;
 use qem_mesh::simplify::{
     simplify, simplify_levels, simplify_observed, BoundaryMode, Contraction, ContractionOrder,
-    Length, NoObserver, Observer, Progress, QuadricMode, Simplified, SimplifyError,
-    SimplifyOptions, StopReason, Target,
+    Length, NoObserver, Observer, Progress, QuadricMode, Simplified, SimplifyOptions, StopReason,
+    Target,
 };
 use qem_mesh::IndexedMesh;
 use std::collections::BTreeSet;
@@ -254,49 +256,56 @@ fn the_orientation_check_stops_flips_and_the_run_still_reaches_its_target() {
     assert!(at(0.02, true).rejected_orientation > 0);
 }
 
-// Each option the pass-based order does not implement, alone on top of FAST, is
-// refused with its own name, and the message names it too.
+// Every option works in both orders: topology preservation keeps a torus a torus
+// (Euler characteristic 0, one part, no border) down to a coarse level, and virtual
+// pairs join two spheres a hair apart; every run replays on the store, and a pair
+// threshold that counts as zero (zero, negative, NaN: documented on `Length`) finds
+// no virtual pair.
 #[test]
-fn options_the_passes_lack_are_refused_by_name() {
-    let sphere = uv_sphere([0.0; 3], 1.0, 6, 8);
-    let cases = [
-        (
-            fast(Target::Ratio(0.5)).with_preserve_topology(true),
-            "preserve_topology = true",
-        ),
-        (
-            fast(Target::Ratio(0.5)).with_pair_threshold(Length::DiagonalFraction(0.01)),
-            "pair_threshold above zero (virtual pairs)",
-        ),
-        (
-            fast(Target::Ratio(0.5)).with_pair_threshold(Length::Absolute(0.1)),
-            "pair_threshold above zero (virtual pairs)",
-        ),
-        // The defaults with a pair threshold (virtual pairs).
-        (
-            SimplifyOptions::DEFAULT
-                .with_order(ContractionOrder::Passes)
-                .with_pair_threshold(Length::DiagonalFraction(0.01)),
-            "pair_threshold above zero (virtual pairs)",
-        ),
-    ];
-    for (options, name) in cases {
-        let err = simplify(&sphere, &options).unwrap_err();
-        assert_eq!(err, SimplifyError::NotInPasses { option: name });
-        let message = err.to_string();
-        assert!(message.contains(name), "{message}");
-        assert!(message.contains("ContractionOrder::Passes"), "{message}");
-    }
-    // A zero threshold, relative or absolute, is edges only: accepted; so are a
-    // negative and a NaN one, which count as zero (documented on `Length`).
-    for zero in [
-        Length::DiagonalFraction(0.0),
-        Length::Absolute(0.0),
-        Length::DiagonalFraction(-0.5),
-        Length::Absolute(f64::NAN),
-    ] {
-        let out = simplify(&sphere, &fast(Target::Ratio(0.5)).with_pair_threshold(zero));
-        assert!(out.is_ok(), "{zero:?}: {out:?}");
+fn topology_and_virtual_pairs_work_in_both_orders() {
+    let ring = torus(1.0, 0.3, 24, 12);
+    let spheres = concat(&[
+        uv_sphere([0.0; 3], 1.0, 12, 24),
+        uv_sphere([2.001, 0.0, 0.0], 1.0, 12, 24),
+    ]);
+    for order in [ContractionOrder::Greedy, ContractionOrder::Passes] {
+        let base = SimplifyOptions::DEFAULT.with_order(order);
+        let kept = base
+            .clone()
+            .with_target(Target::Ratio(0.05))
+            .with_preserve_topology(true);
+        let out = simplify_replayed(&ring, &kept).expect("simplifies");
+        assert_valid(&out.mesh, ring.triangle_count());
+        assert_eq!(topology(&out.mesh), (0, 1, 0), "{order:?}");
+        assert!(
+            out.mesh.triangle_count() < ring.triangle_count() / 5,
+            "{order:?}"
+        );
+
+        let joined = base
+            .clone()
+            .with_target(Target::Ratio(0.1))
+            .with_pair_threshold(Length::Absolute(0.01));
+        let out = simplify_replayed(&spheres, &joined).expect("simplifies");
+        assert_valid(&out.mesh, spheres.triangle_count());
+        assert!(out.report.virtual_pairs > 0, "{order:?}: {:?}", out.report);
+        assert!(
+            out.report.virtual_contractions > 0,
+            "{order:?}: {:?}",
+            out.report
+        );
+        assert_eq!(topology(&out.mesh).1, 1, "{order:?}: the parts joined");
+
+        for zero in [
+            Length::DiagonalFraction(0.0),
+            Length::Absolute(0.0),
+            Length::DiagonalFraction(-0.5),
+            Length::Absolute(f64::NAN),
+        ] {
+            let o = base.clone().with_pair_threshold(zero);
+            let out = simplify_replayed(&spheres, &o).expect("simplifies");
+            assert_eq!(out.report.virtual_pairs, 0, "{zero:?}");
+        }
     }
 }
 

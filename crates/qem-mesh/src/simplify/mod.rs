@@ -1,36 +1,52 @@
-//! The contraction loop: Garland–Heckbert pair contraction on any triangle input.
+//! The contraction engine: Garland–Heckbert pair contraction on any triangle input.
 //!
-//! validate → clean → build the store → face quadrics → vertex quadrics (+ border
-//! planes) → candidate pairs (every edge, plus virtual pairs closer than t) → queue →
-//! loop { pop the cheapest; skip it if stale; stop on the target or the error bound;
-//! check it (locks, fold-over, topology); contract; merge the quadrics; re-cost the
-//! pairs around the new vertex } → compact → report.
+//! validate → clean → the working mesh in locality order (flat arrays: positions,
+//! quadrics, triangles, the live triangles around each vertex) → face quadrics →
+//! vertex quadrics (+ border planes or locks) → virtual pairs (closer than t) → the
+//! order's loop { the next pair; its one attempt (lock order, placement, error bound,
+//! checks, orientation and waiver, contraction, counters, event) } → compact →
+//! report.
+//!
+//! The order is a policy of the one engine ([`ContractionOrder`]): `greedy` (a heap of
+//! every pair, the cheapest first, the pairs at the new vertex re-costed) or `passes`
+//! (each pass costs every pair and contracts the cheapest independent ones). Both run
+//! the same attempt of a pair, the same checks and the same bookkeeping, and every
+//! option works in both.
 //!
 //! Quadrics are computed in the normalised [`Frame`] of the cleaned input (coordinates
-//! in `[-1, 1]`), while the store keeps world coordinates, so vertices that are never
-//! moved come out bit for bit as they went in.
+//! in `[-1, 1]`), while world coordinates are kept beside them, so vertices that are
+//! never moved come out bit for bit as they went in.
 //!
-//! Submodules, one job each: `options` (what a run may do), `report` (what it did),
-//! `observer` (progress, cancellation, per-contraction events), `engine` (the loop),
-//! `checks` (which contractions are allowed), `exact` (the inclusion–exclusion
-//! bookkeeping of [`QuadricMode::Exact`]), `passes` (the pass-based order,
-//! [`ContractionOrder::Passes`], on flat arrays instead of the store: the same checks
-//! but no heap; [`SimplifyOptions::FAST`]), `pass_exact` (exact quadrics in that
-//! order), `orientation` (the orientation check's index, both orders), `waivers`
-//! (pairs the orientation check refused, in the pass-based order).
+//! Submodules, one job each: `options` (what a run may do), `settings` (options become
+//! what the engine reads, in one place), `report` and `counters` (what it did),
+//! `observer` (progress, cancellation, per-contraction events), `passes` (the working
+//! mesh, its setup and the one attempt sequence; the pass-based order), `greedy` (the
+//! greedy order), `pass_blocks` (the checks on the working mesh, and the pass-based
+//! order's block workers), `incidence` (per-vertex lists that contractions merge),
+//! `pair_set` and `pair_queue` (pairs that follow contractions, and the greedy queue),
+//! `placement` (where a merged vertex goes), `pass_exact` (the bookkeeping of
+//! [`QuadricMode::Exact`]), `checks` (the fold-over rules), `orientation` (the
+//! orientation check's index), `waivers` (pairs the orientation check refused),
+//! `locality` (the vertex order), `nth_key` (the batch bound), `replay` (the store as
+//! the engine's oracle).
 
 mod checks;
-mod engine;
-mod exact;
+mod counters;
+mod incidence;
 mod locality;
 mod nth_key;
 mod observer;
 mod options;
 mod orientation;
+mod pair_queue;
+mod pair_set;
 mod pass_blocks;
 mod pass_exact;
 mod passes;
+mod placement;
+mod replay;
 mod report;
+mod settings;
 mod waivers;
 
 pub use observer::{Contraction, NoObserver, Observer, Progress};
@@ -39,14 +55,11 @@ pub use options::{
     VirtualPairs, Weighting, DEFAULT_BOUNDARY_WEIGHT, DEFAULT_MAX_NORMAL_ANGLE,
     DEFAULT_MIN_TRIANGLE_QUALITY, DEFAULT_WEIGHTING_MIX,
 };
+pub use replay::StoreReplay;
 pub use report::{Simplified, SimplifyError, SimplifyReport, StopReason, Timings};
 
 use crate::clean::{clean, CleanOptions, Cleaned};
-use crate::store::build::kept_triangles;
-use crate::store::{slot_index, BuildStats, FaceKey, MeshStore, SlotVec};
 use crate::IndexedMesh;
-use engine::{Counters, Engine};
-use locality::{in_locality_order, in_original_order, Renumbered};
 use passes::PassEngine;
 use qem_core::{DVec3, Frame};
 use std::time::Instant;
@@ -162,30 +175,21 @@ pub fn simplify_levels(
     timings.clean = clock.elapsed();
 
     let frame = Frame::from_points(cleaned.mesh.positions.iter().map(|p| DVec3::from_array(*p)));
-    let mut run = match options.order {
-        ContractionOrder::Greedy => {
-            let (engine, numbers) = set_up_greedy(&cleaned, frame, &locked, options, &mut timings)?;
-            Run::Greedy(engine, numbers)
-        }
-        ContractionOrder::Passes => {
-            refuse_what_passes_lack(options, &frame)?;
-            let clock = Instant::now();
-            // As in the greedy setup: the orientation check's index on the other core.
-            let (mut engine, input_surface) = rayon::join(
-                || PassEngine::new(&cleaned.mesh, frame, &locked, options),
-                || {
-                    options
-                        .orientation_check
-                        .then(|| orientation::InputSurface::new(&cleaned.mesh, &frame))
-                },
-            );
-            if let Some((surface, slots)) = input_surface {
-                engine.set_input_surface(surface, &slots);
-            }
-            timings.setup = clock.elapsed();
-            Run::Passes(engine)
-        }
-    };
+    let clock = Instant::now();
+    // The orientation check's index is independent of the rest of the setup: built on
+    // the other core meanwhile (deterministic either way).
+    let (mut engine, input_surface) = rayon::join(
+        || PassEngine::new(&cleaned.mesh, frame, &locked, options),
+        || {
+            options
+                .orientation_check
+                .then(|| orientation::InputSurface::new(&cleaned.mesh, &frame))
+        },
+    );
+    if let Some((surface, slots)) = input_surface {
+        engine.set_input_surface(surface, &slots);
+    }
+    timings.setup = clock.elapsed();
     observer.cleaned(&cleaned.mesh, &frame);
     // The loop needs the cleaned mesh no more: gone before it starts (about 120 MB on
     // a 4M-triangle mesh), since it runs far longer than the setup and holds the most.
@@ -198,7 +202,10 @@ pub fn simplify_levels(
         let clock = Instant::now();
         let stop_reason = match stopped_short {
             Some(reason) => reason,
-            None => run.run(target_triangles, options, observer)?,
+            None => match options.order {
+                ContractionOrder::Greedy => engine.run_greedy(target_triangles, observer),
+                ContractionOrder::Passes => engine.run(target_triangles, observer),
+            },
         };
         if stop_reason != StopReason::TargetReached {
             stopped_short = Some(stop_reason);
@@ -206,13 +213,18 @@ pub fn simplify_levels(
         timings.contract += clock.elapsed();
 
         let clock = Instant::now();
-        let mut raw = run.to_mesh();
+        let mut raw = engine.to_mesh();
         // Zero area is judged in the loop's frame, not in the output's own (see
-        // `Engine::is_zero_area`): the loop refused every contraction that would make a
+        // `checks::is_zero_area`): the loop refused every contraction that would make a
         // face zero-area, so this drops only faces that came in so (cleaning passes off).
         let before = raw.triangles.len();
-        raw.triangles
-            .retain(|t| !run.is_zero_area(t.map(|i| raw.positions[i as usize])));
+        raw.triangles.retain(|t| {
+            !checks::is_zero_area(
+                &engine.frame,
+                &engine.settings,
+                t.map(|i| raw.positions[i as usize]),
+            )
+        });
         let zero_area_dropped = before - raw.triangles.len();
         let final_clean = clean(&raw, &CleanOptions::OUTPUT.with_drop_zero_area(false));
         let out = final_clean.mesh;
@@ -223,7 +235,7 @@ pub fn simplify_levels(
         }
         timings.compact = clock.elapsed();
 
-        let counters = run.counters();
+        let counters = engine.counters;
         let report = SimplifyReport {
             triangles_in: mesh.triangle_count(),
             vertices_in: mesh.vertex_count(),
@@ -249,174 +261,12 @@ pub fn simplify_levels(
             rejected_merge: counters.rejected_merge,
             rejected_orientation: counters.rejected_orientation,
             locked_vertices: counters.locked_vertices,
-            faces_flipped: run.flipped_faces(),
+            faces_flipped: engine.flipped_faces(),
             timings,
         };
         results.push(Simplified { mesh: out, report });
     }
     Ok(results)
-}
-
-/// The greedy loop's store, quadrics, queue and (on the other core meanwhile) the
-/// orientation check's index, built from the cleaned mesh in locality order (see
-/// [`locality`]); and the cleaned number of each of the store's faces.
-fn set_up_greedy(
-    cleaned: &Cleaned,
-    frame: Frame,
-    locked: &[u32],
-    options: &SimplifyOptions,
-    timings: &mut Timings,
-) -> Result<(Engine, CleanedNumbers), SimplifyError> {
-    let clock = Instant::now();
-    let Renumbered {
-        mesh,
-        vertex_from,
-        vertex_to,
-        triangle_from,
-    } = in_locality_order(&cleaned.mesh, &frame);
-    let (store, keys) = MeshStore::from_mesh(&mesh)?;
-    timings.build = clock.elapsed();
-    let locked: Vec<u32> = locked
-        .iter()
-        .filter_map(|&i| vertex_to.get(i as usize).copied())
-        .collect();
-    drop(vertex_to);
-
-    // The store's faces are the triangles it kept, in order (it never adds one).
-    let kept: Vec<u32> = if store.face_count() == mesh.triangles.len() {
-        (0..mesh.triangles.len() as u32).collect()
-    } else {
-        kept_triangles(
-            &mesh.triangles,
-            mesh.positions.len(),
-            &mut BuildStats::default(),
-        )
-    };
-    let mut face_from = SlotVec::for_keys(store.faces(), u32::MAX);
-    for (f, &t) in store.faces().zip(&kept) {
-        face_from.set(f, triangle_from[t as usize]);
-    }
-    // The store holds its own copy: gone before the setup's peak.
-    drop((mesh, kept));
-
-    let mut engine = Engine::new(store, frame, options);
-    let clock = Instant::now();
-    // The orientation check's index is independent of the quadrics and queue: built on
-    // the other core meanwhile (deterministic either way).
-    let ((), input_surface) = rayon::join(
-        || engine.initialise(&keys, &vertex_from, &locked, options),
-        || {
-            options
-                .orientation_check
-                .then(|| orientation::InputSurface::new(&cleaned.mesh, &frame))
-        },
-    );
-    // Each face's search hint starts as its own input triangle.
-    engine.input_surface = input_surface.map(|(mut surface, slots)| {
-        surface.seed_hints(
-            engine
-                .store
-                .faces()
-                .map(|f| (slot_index(f), slots[*face_from.get(f) as usize])),
-        );
-        surface
-    });
-    timings.setup = clock.elapsed();
-    let numbers = CleanedNumbers {
-        vertex_count: cleaned.mesh.positions.len(),
-        face_from,
-    };
-    Ok((engine, numbers))
-}
-
-/// What the greedy loop's output needs to be numbered back into the cleaned mesh's
-/// numbers and order (its vertices carry their own, see `VertexState::index`).
-struct CleanedNumbers {
-    /// The cleaned mesh's vertex count.
-    vertex_count: usize,
-    /// The cleaned triangle each store face was made from.
-    face_from: SlotVec<FaceKey, u32>,
-}
-
-/// [`SimplifyError::NotInPasses`] for the first option set that the pass-based order
-/// does not implement.
-fn refuse_what_passes_lack(options: &SimplifyOptions, frame: &Frame) -> Result<(), SimplifyError> {
-    let lacking = if options.preserve_topology {
-        Some("preserve_topology = true")
-    } else if options.pair_threshold.normalized(frame) > 0.0 {
-        Some("pair_threshold above zero (virtual pairs)")
-    } else {
-        None
-    };
-    match lacking {
-        Some(option) => Err(SimplifyError::NotInPasses { option }),
-        None => Ok(()),
-    }
-}
-
-/// A run in either order, as the level loop of [`simplify_levels`] drives it.
-// One value per run, made once: the size of the larger variant costs nothing.
-#[allow(clippy::large_enum_variant)]
-enum Run {
-    /// The greedy loop, and how to number its output back.
-    Greedy(Engine, CleanedNumbers),
-    Passes(PassEngine),
-}
-
-impl Run {
-    fn run(
-        &mut self,
-        target: usize,
-        options: &SimplifyOptions,
-        observer: &mut dyn Observer,
-    ) -> Result<StopReason, SimplifyError> {
-        match self {
-            Run::Greedy(engine, _) => engine.run(target, options, observer),
-            Run::Passes(engine) => Ok(engine.run(target, observer)),
-        }
-    }
-
-    fn to_mesh(&self) -> IndexedMesh {
-        match self {
-            Run::Greedy(engine, numbers) => {
-                let (mesh, keys) = engine.store.to_mesh_with_map();
-                // Every live vertex has a state (its cleaned number).
-                let vertex_from: Vec<u32> = keys.iter().map(|&v| engine.state[v].index).collect();
-                let triangle_from: Vec<u32> = engine
-                    .store
-                    .faces()
-                    .map(|f| *numbers.face_from.get(f))
-                    .collect();
-                in_original_order(mesh, numbers.vertex_count, &vertex_from, &triangle_from)
-            }
-            Run::Passes(engine) => engine.to_mesh(),
-        }
-    }
-
-    /// Whether the loop counts a face with these world corners as zero-area (see
-    /// `Engine::is_zero_area`).
-    fn is_zero_area(&self, world_corners: [[f64; 3]; 3]) -> bool {
-        match self {
-            Run::Greedy(engine, _) => engine.is_zero_area(world_corners),
-            Run::Passes(engine) => {
-                checks::is_zero_area(&engine.frame, &engine.settings, world_corners)
-            }
-        }
-    }
-
-    fn counters(&self) -> Counters {
-        match self {
-            Run::Greedy(engine, _) => engine.counters,
-            Run::Passes(engine) => engine.counters,
-        }
-    }
-
-    fn flipped_faces(&self) -> usize {
-        match self {
-            Run::Greedy(engine, _) => engine.flipped_faces(),
-            Run::Passes(engine) => engine.flipped_faces(),
-        }
-    }
 }
 
 /// The triangle count a target asks for, given the input's count as loaded.

@@ -45,6 +45,9 @@ pub struct Contraction {
     pub quadric: Quadric,
     /// The new position, normalised frame.
     pub position: DVec3,
+    /// The same position in model units, as the output holds it (bit for bit where
+    /// the kept vertex was, when an end is locked).
+    pub world: [f64; 3],
     /// `quadric` evaluated at the chosen position (clamped to be non-negative).
     pub cost: f64,
 }

@@ -145,31 +145,29 @@ pub enum VirtualPairs {
     BetweenComponents,
 }
 
-/// In which order pairs are contracted.
+/// In which order pairs are contracted: a policy of the one engine. Every other option
+/// works in both orders (virtual pairs, topology preservation, exact quadrics, the
+/// orientation check, locks, borders, levels of detail, the error bound), with the
+/// same checks and the same attempt of each pair.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ContractionOrder {
-    /// Garland–Heckbert's: always the cheapest pair next, its neighbours re-costed
-    /// after every contraction (a heap over the store). Every option is available.
+    /// Garland–Heckbert's: always the cheapest pair next (a heap of every edge and
+    /// virtual pair), the pairs at the new vertex re-costed after every contraction.
+    /// A refused pair waits until one of its ends moves.
     Greedy,
-    /// In passes over flat arrays: each pass costs every edge once and contracts a
-    /// batch of the cheapest, no two sharing a vertex, each checked like the greedy
-    /// loop's (fold-over, merged faces, border loops, locks). Several times faster, at
-    /// a small loss of quality: an edge whose cost fell during a pass waits for the
-    /// next one. Edges only, and without topology preservation:
-    /// [`simplify`](super::simplify) refuses `preserve_topology` and a
-    /// `pair_threshold` above zero with
-    /// [`SimplifyError::NotInPasses`](super::SimplifyError::NotInPasses). Exact
-    /// quadrics and the orientation check are available (a pair the check refuses is
-    /// ranked at the same penalty in later passes and tried without the check next
-    /// time, unless one of its ends moves first).
-    /// [`SimplifyOptions::FAST`] is the defaults with this order, summed quadrics, no
-    /// orientation check and [`PlacementMode::SolveFirst`]. With a
-    /// [`max_error`](SimplifyOptions::max_error) bound, a pair over the bound is never
-    /// contracted but does not end the run either; the run stops with
+    /// meshoptimizer's: in passes, each costing every pair once and contracting a batch
+    /// of the cheapest, no two sharing a vertex (several times faster on two cores, at a
+    /// small loss of quality: a pair whose cost fell during a pass waits for the next
+    /// one). A pair the orientation check refuses is ranked at the waivers' penalty in
+    /// later passes and tried without the check next time, unless one of its ends moves
+    /// first. With a [`max_error`](SimplifyOptions::max_error) bound, a pair over the
+    /// bound is never contracted but does not end the run either; the run stops with
     /// [`StopReason::MaxErrorReached`](super::StopReason::MaxErrorReached) when a pass
     /// contracts nothing and met at least one pair over the bound (and with
     /// [`StopReason::NoValidPair`](super::StopReason::NoValidPair) when the checks
-    /// refused every pair under it).
+    /// refused every pair under it). [`SimplifyOptions::FAST`] is the defaults with
+    /// this order, summed quadrics, no orientation check and
+    /// [`PlacementMode::SolveFirst`].
     Passes,
 }
 
@@ -260,12 +258,6 @@ pub struct SimplifyOptions {
     pub clean: CleanOptions,
     /// In which order pairs are contracted. Default: `ContractionOrder::Greedy`.
     pub order: ContractionOrder,
-    /// Run the store's full invariant check ([`MeshStore::validate`](crate::MeshStore::validate))
-    /// after every contraction and fail with
-    /// [`SimplifyError::Internal`](super::SimplifyError::Internal) if it breaks. For
-    /// tests: it costs O(n) per contraction. The pass-based order has no store and
-    /// ignores it. Default: `false`.
-    pub validate_each_contraction: bool,
 }
 
 /// The default border-plane weight of [`BoundaryMode::Planes`]: a border plane then
@@ -333,7 +325,6 @@ impl SimplifyOptions {
         locked_vertices: Vec::new(),
         clean: CleanOptions::DEFAULT,
         order: ContractionOrder::Greedy,
-        validate_each_contraction: false,
     };
 
     /// [`DEFAULT`](Self::DEFAULT) in [`ContractionOrder::Passes`], with summed quadrics
@@ -381,7 +372,6 @@ impl SimplifyOptions {
         locked_vertices: Vec::new(),
         clean: CleanOptions::DEFAULT,
         order: ContractionOrder::Passes,
-        validate_each_contraction: false,
     };
 
     /// Sets [`target`](Self::target).
@@ -465,12 +455,6 @@ impl SimplifyOptions {
     /// Sets [`locked_vertices`](Self::locked_vertices).
     pub fn with_locked_vertices(mut self, vertices: Vec<u32>) -> Self {
         self.locked_vertices = vertices;
-        self
-    }
-
-    /// Sets [`validate_each_contraction`](Self::validate_each_contraction).
-    pub fn with_validate_each_contraction(mut self, on: bool) -> Self {
-        self.validate_each_contraction = on;
         self
     }
 

@@ -34,10 +34,13 @@
 //! "Rounds block by block".)
 
 use super::checks::{moved_face_verdict, Rejection};
-use super::engine::{place_merged, Counters, Settings};
+use super::counters::Counters;
+use super::incidence::Incidence;
 use super::observer::Contraction;
 use super::orientation::Nearest;
-use super::pass_exact::{shorter_list, PassExact};
+use super::pass_exact::PassExact;
+use super::placement::place_merged;
+use super::settings::Settings;
 use super::waivers::Waivers;
 use crate::clean::cross_underflows;
 use qem_core::{DVec3, Frame, Quadric};
@@ -69,10 +72,8 @@ pub(super) struct Around {
 pub(super) struct Fixed<'a> {
     pub frame: &'a Frame,
     pub settings: &'a Settings,
-    /// The live triangles around each vertex at the pass's start:
-    /// `incident[first[v]..first[v + 1]]`.
-    pub first: &'a [u32],
-    pub incident: &'a [u32],
+    /// The live triangles around each vertex at the pass's start.
+    pub incidence: &'a Incidence,
     /// Each input triangle's normal (normalised frame).
     pub original_normals: &'a [DVec3],
     /// Each engine vertex's number in the cleaned mesh (for the observer).
@@ -81,6 +82,9 @@ pub(super) struct Fixed<'a> {
     /// Exact quadrics' planes as of the pass's start (`None`: summed quadrics). A
     /// contraction's changes to them wait in [`BlockOutcome::exact_changes`].
     pub exact: Option<&'a PassExact>,
+    /// Whether there are virtual pairs, whose ends a contraction renames (the
+    /// contractions wait in [`BlockOutcome::merges`]).
+    pub has_virtual_pairs: bool,
     /// The orientation check's index (`None`: the check is off); the hints are the
     /// slab's.
     pub nearest: Option<Nearest<'a>>,
@@ -105,7 +109,7 @@ impl Corners<'_> {
         self.world[(v - self.first_vertex) as usize]
     }
 
-    /// The greedy loop's fold-over check (see `Engine::fold_over`) of contracting the
+    /// The fold-over check of contracting the
     /// pair `a b` to `world` (model units): every triangle of `around` that moves and
     /// does not collapse.
     pub fn fold_over(
@@ -194,8 +198,7 @@ impl<'a> Slab<'a> {
     /// slab. Reads no triangle outside the slab.
     pub fn gather(&self, fixed: &Fixed, v: u32, out: &mut Vec<Around>) -> bool {
         out.clear();
-        let range = fixed.first[v as usize] as usize..fixed.first[v as usize + 1] as usize;
-        for &t in &fixed.incident[range] {
+        for &t in fixed.incidence.of(v) {
             let Some(slot) = self.triangle_slot(t) else {
                 return false;
             };
@@ -360,6 +363,8 @@ pub(super) struct BlockOutcome {
     pub waiver_changes: Vec<WaiverChange>,
     /// Each contraction's changes to exact quadrics' planes, in order.
     pub exact_changes: Vec<ExactChange>,
+    /// Each contraction (kept, removed), in order, when there are virtual pairs.
+    pub merges: Vec<[u32; 2]>,
 }
 
 /// A contraction's change to exact quadrics' planes, for the caller to make with
@@ -417,7 +422,9 @@ pub(super) fn contract_block(
             continue;
         }
         let shared = around[0].iter().filter(|x| x.corners.contains(&b)).count();
-        if shared > 2 {
+        // Virtual pairs (no triangle on both) go to the sequential attempts, which
+        // count them apart.
+        if shared > 2 || shared == 0 {
             out.deferred.push(i);
             continue;
         }
@@ -426,7 +433,7 @@ pub(super) fn contract_block(
         let mut q = slab.quadric[sa] + slab.quadric[sb];
         if let Some(exact) = fixed.exact {
             let triangles = (slab.first_triangle, &*slab.triangles);
-            q -= shared_planes(fixed.first, fixed.incident, triangles, exact, [a, b]);
+            q -= shared_planes(fixed.incidence, triangles, exact, [a, b]);
         }
         let ends = [(slab.position[sa], false), (slab.position[sb], false)];
         let placed = place_merged(&q, ends, fixed.settings.placement);
@@ -481,6 +488,9 @@ pub(super) fn contract_block(
                 collapsed,
             });
         }
+        if fixed.has_virtual_pairs {
+            out.merges.push([a, b]);
+        }
         out.removed += slab.contract(fixed, [a, b], world, q, &around);
         out.contracted += 1;
         out.counters.edge_contractions += 1;
@@ -492,6 +502,7 @@ pub(super) fn contract_block(
                 is_virtual: false,
                 quadric: q,
                 position: placed.position,
+                world: world.to_array(),
                 cost: placed.cost,
             });
         }
@@ -514,10 +525,109 @@ pub(super) fn plain_checks(
     if would_merge_faces(a, b, around) {
         return Err(Rejection::Merge);
     }
-    if fixed.settings.keep_border_loops && !keeps_border_loops(a, b, shared, around) {
+    // A virtual pair (no triangle on both) joins parts or closes a gap: it pinches
+    // no border loop of its own, which is what it is for.
+    if fixed.settings.keep_border_loops && shared > 0 && !keeps_border_loops(a, b, shared, around) {
         return Err(Rejection::Border);
     }
+    if fixed.settings.preserve_topology && !keeps_topology(a, b, shared, around) {
+        return Err(Rejection::Topology);
+    }
     Ok(())
+}
+
+/// Whether a vertex's star (`around`, its live triangles) is one fan of triangles
+/// joined edge to edge, every edge at the vertex on one or two of them: `Some(true)`
+/// when the fan is open (the vertex is on a border), `Some(false)` when it is closed,
+/// `None` for any other star (non-manifold, or no triangle).
+fn manifold_star(v: u32, around: &[Around]) -> Option<bool> {
+    if around.is_empty() {
+        return None;
+    }
+    // (neighbour, triangle's place in `around`), sorted: each run is one edge at `v`.
+    let mut ends: SmallVec<[(u32, u32); 24]> = SmallVec::new();
+    for (i, x) in around.iter().enumerate() {
+        for c in x.corners {
+            if c != v {
+                ends.push((c, i as u32));
+            }
+        }
+    }
+    ends.sort_unstable();
+    let mut group: SmallVec<[u32; 12]> = (0..around.len() as u32).collect();
+    let root = |group: &mut SmallVec<[u32; 12]>, mut i: u32| {
+        while group[i as usize] != i {
+            group[i as usize] = group[group[i as usize] as usize];
+            i = group[i as usize];
+        }
+        i
+    };
+    let mut border_edges = 0;
+    for run in ends.chunk_by(|p, q| p.0 == q.0) {
+        match run {
+            [_] => border_edges += 1,
+            [(_, i), (_, j)] => {
+                let (ri, rj) = (root(&mut group, *i), root(&mut group, *j));
+                group[ri.max(rj) as usize] = ri.min(rj);
+            }
+            _ => return None,
+        }
+    }
+    let one_fan = (0..around.len() as u32).all(|i| root(&mut group, i) == 0);
+    match (one_fan, border_edges) {
+        (true, 0) => Some(false),
+        (true, 2) => Some(true),
+        _ => None,
+    }
+}
+
+/// The link condition of Dey, Edelsbrunner, Guha and Nekhayev ("Topology preserving
+/// edge contraction", 1999) for the edge `a b` (on `shared` triangles) of a 2-manifold
+/// with border, and a refusal elsewhere (a virtual pair, a non-manifold edge or star).
+///
+/// `Lk a ∩ Lk b = Lk ab`: the vertices joined to both `a` and `b` are exactly the
+/// third corners of the triangles on `a b`, and no edge `x y` is in both links (two
+/// triangles `a x y` and `b x y`; such a pair would merge, which `would_merge_faces`
+/// refuses). For a border, their extension cones the border off with a dummy vertex ω
+/// (a triangle `x y ω` for every border edge `x–y`): ω is a common neighbour when both
+/// ends are on a border, so `a b` must be a border edge itself; and `x ω` is a common
+/// link edge when `a–x` and `b–x` are both border edges, which would close a border
+/// loop of three edges (or collapse a lone triangle).
+fn keeps_topology(a: u32, b: u32, shared: usize, around: &[Vec<Around>; 2]) -> bool {
+    if !(1..=2).contains(&shared) {
+        return false;
+    }
+    let (Some(a_border), Some(b_border)) =
+        (manifold_star(a, &around[0]), manifold_star(b, &around[1]))
+    else {
+        return false;
+    };
+    if a_border && b_border && shared != 1 {
+        return false;
+    }
+    let neighbours = |v: u32, star: &[Around]| {
+        let mut n: SmallVec<[u32; 16]> = star
+            .iter()
+            .flat_map(|x| x.corners)
+            .filter(|&c| c != v)
+            .collect();
+        n.sort_unstable();
+        n.dedup();
+        n
+    };
+    let (of_a, of_b) = (neighbours(a, &around[0]), neighbours(b, &around[1]));
+    let opposite: SmallVec<[u32; 2]> = around[0]
+        .iter()
+        .filter(|x| x.corners.contains(&b))
+        .filter_map(|x| x.corners.into_iter().find(|&c| c != a && c != b))
+        .collect();
+    let common_beyond_the_edge = of_a
+        .iter()
+        .any(|&x| x != b && of_b.binary_search(&x).is_ok() && !opposite.contains(&x));
+    if common_beyond_the_edge {
+        return false;
+    }
+    !(a_border && b_border) || keeps_border_loops(a, b, shared, around)
 }
 
 /// The neighbours of `v` joined to it by a border edge (exactly one triangle of
@@ -567,7 +677,7 @@ fn listed_once(ends: &mut [u32]) -> SmallVec<[u32; 8]> {
 const SMALL_STAR: usize = 16;
 
 /// Whether contracting the edge `a b` would merge a triangle `a x y` with a triangle
-/// `b x y` (see `Engine::would_merge_faces`).
+/// `b x y` (two faces on the same three vertices after it).
 fn would_merge_faces(a: u32, b: u32, around: &[Vec<Around>; 2]) -> bool {
     around[1].iter().any(|y| {
         if y.corners.contains(&a) {
@@ -584,7 +694,7 @@ fn would_merge_faces(a: u32, b: u32, around: &[Vec<Around>; 2]) -> bool {
 }
 
 /// Whether contracting the edge `a b` (held by `shared` triangles) keeps every border
-/// loop (see `Engine::keeps_border_loops`): when both ends are on a border, `a b` must
+/// loop: when both ends are on a border, `a b` must
 /// be a border edge, and no third vertex may be joined to both by border edges.
 fn keeps_border_loops(a: u32, b: u32, shared: usize, around: &[Vec<Around>; 2]) -> bool {
     let a_border = border_neighbours(a, &around[0]);
@@ -605,7 +715,7 @@ fn keeps_border_loops(a: u32, b: u32, shared: usize, around: &[Vec<Around>; 2]) 
 
 /// `Q_ab` of exact quadrics (see [`super::pass_exact`]) for `a` and `b`, both unmoved in
 /// this pass: the face planes of the live triangles on both, then the segments joining
-/// them. `first` and `incident` are the pass's lists of triangles around each vertex;
+/// them. `incidence` lists the triangles around each vertex;
 /// `triangles` holds the triangles from the number it is paired with on, which must
 /// include every triangle around `a` and `b`.
 ///
@@ -615,15 +725,14 @@ fn keeps_border_loops(a: u32, b: u32, shared: usize, around: &[Vec<Around>; 2]) 
 /// holds the triangles on both ends in increasing order, so the sum is the same to the
 /// bit whichever is walked.
 pub(super) fn shared_planes(
-    first: &[u32],
-    incident: &[u32],
+    incidence: &Incidence,
     (first_triangle, triangles): (u32, &[[u32; 3]]),
     exact: &PassExact,
     [a, b]: [u32; 2],
 ) -> Quadric {
-    let ((_, other), range) = shorter_list(first, a, b);
+    let (walked, other) = incidence.shorter(a, b);
     let mut sum = Quadric::ZERO;
-    for &t in &incident[range] {
+    for &t in incidence.of(walked) {
         let corners = triangles[(t - first_triangle) as usize];
         if corners[0] != REMOVED && corners.contains(&other) {
             sum += exact.face_quadric(t);

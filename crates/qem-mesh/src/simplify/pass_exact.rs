@@ -1,13 +1,13 @@
-//! [`QuadricMode::Exact`](super::QuadricMode::Exact) in the pass-based order: the
-//! quadric of a contracted pair is that of the *union* of the two plane sets,
-//! `Q_a + Q_b − Q_ab` (see [`super::exact`] for the greedy loop's bookkeeping and the
-//! argument).
+//! [`QuadricMode::Exact`](super::QuadricMode::Exact), in both orders: the quadric of a
+//! contracted pair is that of the *union* of the two plane sets, `Q_a + Q_b − Q_ab`
+//! (inclusion–exclusion; Edelsbrunner, *Geometry and Topology for Mesh Generation*):
+//! the plain sum counts every plane the two vertices share twice.
 //!
 //! Every input plane has a support: the input vertices it belongs to (a face plane:
 //! its triangle's three corners; a border plane: its edge's two ends). `Q_ab` is the
 //! sum of the planes whose support meets both `a`'s group and `b`'s, that is, whose
-//! support's *current* vertices include both `a` and `b`. The pass-based order keeps
-//! those planes where it can find them from an edge:
+//! support's *current* vertices include both `a` and `b`. The engine keeps those
+//! planes where it can find them from a pair:
 //! - a live triangle holds its face plane, with its current corners;
 //! - a plane whose support is down to two current vertices is a [`Segment`]: a border
 //!   plane from the start, or the face plane of a triangle that collapsed (its two
@@ -16,26 +16,29 @@
 //!   and is forgotten.
 //!
 //! So `Q_ab` = the face planes of the live triangles on both `a` and `b`, plus the
-//! segments joining them. Segments keep the ends they were made with; each pass
-//! resolves them through the record of which vertex merged into which (so a segment
-//! at a vertex that merged later follows it) and lists them by end. Within a pass, the
-//! pairs asked about have both ends unmoved in that pass, and no segment's resolved
-//! ends change without one of them moving, so the pass's list stays exact for them.
+//! segments joining them. A contraction renames the removed vertex in its segments at
+//! once and merges its list of segments into the kept vertex's ([`Incidence`]), so the
+//! lists are always current; the pass-based order also rebuilds them at each pass, in
+//! index order, so that the sum of a pair's segments has the same bits whichever end's
+//! list is walked.
 
+use super::incidence::Incidence;
 use qem_core::{Quadric, WeightedPlane};
 
 /// A plane supported by exactly two current vertices.
 #[derive(Clone, Copy, Debug)]
 struct Segment {
-    /// Its ends when it was made (resolved through [`PassExact::merged_into`] at the
-    /// start of each pass).
+    /// Its two current ends (kept current by [`PassExact::contract`]).
     ends: [u32; 2],
     /// Its plane: a triangle index (the triangle's face plane), or the triangle count
     /// plus an index into [`PassExact::border_planes`].
     source: u32,
 }
 
-/// The bookkeeping of exact quadrics in a pass-based run.
+/// A segment's ends once they are one vertex: it joins nothing any more.
+const GONE: [u32; 2] = [u32::MAX, u32::MAX];
+
+/// The bookkeeping of exact quadrics in a run (either order).
 #[derive(Debug)]
 pub(super) struct PassExact {
     /// Each input triangle's weighted face plane (the one summed into its corners).
@@ -43,26 +46,25 @@ pub(super) struct PassExact {
     /// The border planes' quadrics, in the order they were added.
     border_planes: Vec<Quadric>,
     segments: Vec<Segment>,
-    /// Per vertex, the vertex it was contracted into, or itself while it lives.
-    merged_into: Vec<u32>,
-    /// The segments by end, as of the start of the pass:
-    /// `by_end[first[v]..first[v + 1]]` are the indices of the segments at `v`.
-    first: Vec<u32>,
-    by_end: Vec<u32>,
+    /// The segments by end (indices into `segments`): rebuilt in index order by
+    /// [`start_pass`](Self::start_pass), merged by [`contract`](Self::contract).
+    by_end: Incidence,
+    vertex_count: usize,
 }
 
 impl PassExact {
     /// No plane yet, for `vertex_count` vertices (the face planes come with
     /// [`set_face_planes`](Self::set_face_planes)).
     pub fn new(vertex_count: usize) -> Self {
-        PassExact {
+        let mut exact = PassExact {
             face_planes: Vec::new(),
             border_planes: Vec::new(),
             segments: Vec::new(),
-            merged_into: (0..vertex_count as u32).collect(),
-            first: Vec::new(),
-            by_end: Vec::new(),
-        }
+            by_end: Incidence::default(),
+            vertex_count,
+        };
+        exact.start_pass();
+        exact
     }
 
     /// Records every triangle's face plane, by triangle index; before any border plane
@@ -82,81 +84,61 @@ impl PassExact {
     pub fn add_border_plane(&mut self, a: u32, b: u32, q: Quadric) {
         let source = (self.face_planes.len() + self.border_planes.len()) as u32;
         self.border_planes.push(q);
-        self.segments.push(Segment {
-            ends: [a, b],
-            source,
-        });
+        self.add_segment([a, b], source);
+    }
+
+    fn add_segment(&mut self, ends: [u32; 2], source: u32) {
+        let i = self.segments.len() as u32;
+        self.segments.push(Segment { ends, source });
+        for v in ends {
+            self.by_end.push(v, i);
+        }
     }
 
     /// Records the contraction of `b` into `a`, whose collapsed triangles are
-    /// `collapsed` (each with its corner other than `a` and `b`).
+    /// `collapsed` (each with its corner other than `a` and `b`): `b`'s segments are
+    /// `a`'s now, those joining `a` and `b` join nothing, and each collapsed
+    /// triangle's plane becomes a segment from `a` to its third corner.
     pub fn contract(&mut self, a: u32, b: u32, collapsed: impl Iterator<Item = (u32, u32)>) {
-        self.merged_into[b as usize] = a;
+        for &i in self.by_end.of(b) {
+            let s = &mut self.segments[i as usize];
+            if s.ends.contains(&a) {
+                s.ends = GONE;
+            } else if s.ends != GONE {
+                s.ends = s.ends.map(|v| if v == b { a } else { v });
+            }
+        }
+        let segments = &self.segments;
+        self.by_end
+            .merge(a, b, |i| segments[i as usize].ends != GONE);
         for (t, x) in collapsed {
-            self.segments.push(Segment {
-                ends: [a, x],
-                source: t,
-            });
+            self.add_segment([a, x], t);
         }
     }
 
-    /// Resolves every segment's ends to current vertices, forgets those whose ends
-    /// are one vertex now, and lists the rest by end (a counting sort).
+    /// Forgets the segments that join nothing, and lists the rest by end again, each
+    /// vertex's in increasing order (a counting sort): the start of a pass.
     pub fn start_pass(&mut self) {
-        let n = self.merged_into.len();
-        let mut segments = std::mem::take(&mut self.segments);
-        for s in &mut segments {
-            s.ends = s.ends.map(|v| self.current(v));
-        }
-        segments.retain(|s| s.ends[0] != s.ends[1]);
-        self.segments = segments;
-        self.first.clear();
-        self.first.resize(n + 1, 0);
-        for s in &self.segments {
-            for v in s.ends {
-                self.first[v as usize + 1] += 1;
-            }
-        }
-        for v in 0..n {
-            self.first[v + 1] += self.first[v];
-        }
-        self.by_end.clear();
-        self.by_end.resize(self.segments.len() * 2, 0);
-        let mut cursor = self.first[..n].to_vec();
-        for (i, s) in self.segments.iter().enumerate() {
-            for v in s.ends {
-                self.by_end[cursor[v as usize] as usize] = i as u32;
-                cursor[v as usize] += 1;
-            }
-        }
+        self.segments.retain(|s| s.ends != GONE);
+        let segments = &self.segments;
+        self.by_end.rebuild(self.vertex_count, || {
+            segments
+                .iter()
+                .enumerate()
+                .flat_map(|(i, s)| s.ends.map(|v| (v, i as u32)))
+        });
     }
 
-    /// The vertex `v` was merged into, through every later contraction (shortening
-    /// the chain as it goes).
-    fn current(&mut self, v: u32) -> u32 {
-        let mut root = v;
-        while self.merged_into[root as usize] != root {
-            root = self.merged_into[root as usize];
-        }
-        let mut w = v;
-        while self.merged_into[w as usize] != root {
-            let next = self.merged_into[w as usize];
-            self.merged_into[w as usize] = root;
-            w = next;
-        }
-        root
-    }
-
-    /// The sum of the segments joining `a` and `b`, both unmoved in this pass.
+    /// The sum of the segments joining `a` and `b`.
     ///
     /// Walks the shorter of the two ends' lists (a vertex that absorbed many others
-    /// has a long one); both list the segments in increasing order, so the sum is the
-    /// same to the bit either way.
+    /// has a long one). After [`start_pass`](Self::start_pass) both list the segments
+    /// in increasing order, so the sum is the same to the bit either way.
     #[inline]
     pub fn segments_between(&self, a: u32, b: u32) -> Quadric {
-        let ((_, other), range) = shorter_list(&self.first, a, b);
+        let (walked, other) = self.by_end.shorter(a, b);
         let mut sum = Quadric::ZERO;
-        for &i in &self.by_end[range] {
+        for &i in self.by_end.of(walked) {
             let s = self.segments[i as usize];
             if s.ends.contains(&other) {
                 sum += self.plane(s.source);
@@ -172,18 +154,6 @@ impl PassExact {
             Some(border) => self.border_planes[border],
             None => self.face_quadric(source),
         }
-    }
-}
-
-/// Of two vertices with lists `by_vertex[first[v]..first[v + 1]]`, the one with the
-/// shorter list (the first on a tie) and the other, and that list's range: the side
-/// to walk when looking for what both share.
-pub(super) fn shorter_list(first: &[u32], a: u32, b: u32) -> ((u32, u32), std::ops::Range<usize>) {
-    let range = |v: u32| first[v as usize] as usize..first[v as usize + 1] as usize;
-    if range(a).len() <= range(b).len() {
-        ((a, b), range(a))
-    } else {
-        ((b, a), range(b))
     }
 }
 

@@ -1,5 +1,7 @@
-//! The pass-based contraction order ([`ContractionOrder::Passes`](super::ContractionOrder::Passes)): flat arrays instead
-//! of the store, and the cheapest pairs contracted in batches instead of one at a time.
+//! The working mesh (flat arrays), its setup, the one attempt of a pair, and the
+//! pass-based order ([`ContractionOrder::Passes`](super::ContractionOrder::Passes)):
+//! the cheapest pairs contracted in batches instead of one at a time. (The greedy
+//! order, [`greedy`], runs on the same mesh with the same attempt.)
 //!
 //! Each pass:
 //! 1. lists, for every vertex, the live triangles around it (one counting sort);
@@ -27,16 +29,15 @@
 //!    when most recent attempts contracted), and the attempts take what still holds
 //!    ([`PassEngine::speculate`] says why that is the sequential answer, bit for bit).
 //!
-//! Why it is faster than [`ContractionOrder::Greedy`](super::ContractionOrder::Greedy): no heap and no store to keep
-//! consistent, each edge costed at most once per pass, and the contractions walk the
-//! arrays in order. What it gives up: the strict greedy order (an edge whose cost fell
-//! during a pass waits for the next one), virtual pairs and topology preservation
-//! (each refused with
-//! [`SimplifyError::NotInPasses`](super::SimplifyError::NotInPasses)). Exact quadrics
-//! keep their planes as [`super::pass_exact`] describes. The orientation check runs
-//! last among the checks, as in the greedy loop; a pair it refuses is ranked at the
-//! greedy loop's penalty in later passes and then tried without it
-//! ([`super::waivers`]).
+//! Why it is faster than [`ContractionOrder::Greedy`](super::ContractionOrder::Greedy):
+//! no heap, each pair costed at most once per pass, the contractions walk the arrays
+//! in order, and much of the work is on both cores. What it gives up: the strict
+//! greedy order (a pair whose cost fell during a pass waits for the next one). Virtual
+//! pairs are listed with the edges of their smaller end (and go to the sequential
+//! attempts, not the blocks). Exact quadrics keep their planes as
+//! [`super::pass_exact`] describes. The orientation check runs last among the checks;
+//! a pair it refuses is ranked at the waivers' penalty in later passes and then tried
+//! without it ([`super::waivers`]).
 //!
 //! The arrays are numbered in locality order ([`super::locality`]: vertices along a
 //! space-filling curve), so "in order" is also "near in space", whatever order the
@@ -55,20 +56,27 @@
 //! triangles it had at the pass's start, minus the removed ones.
 
 use super::checks::Rejection;
-use super::engine::{place_merged, Counters, Settings};
+use super::counters::Counters;
+use super::incidence::Incidence;
 use super::locality::{in_locality_order, in_original_order, Renumbered};
 use super::nth_key::nth_key;
 use super::observer::{Contraction, Observer, Progress};
 use super::options::QuadricMode;
+use super::options::VirtualPairs;
 use super::options::{BoundaryMode, SimplifyOptions};
 use super::orientation::{InputSurface, Quick};
+use super::pair_set::PairSet;
 use super::pass_blocks::{
     border_neighbours, contract_block, plain_checks, shared_planes, Around, BlockOutcome,
     Candidate, Corners, Fixed, Slab, WaiverChange, BLOCK_VERTICES, REMOVED,
 };
 use super::pass_exact::PassExact;
+use super::placement::place_merged;
 use super::report::StopReason;
+use super::settings::Settings;
 use super::waivers::{penalised, Waivers};
+use crate::inspect::{find, union};
+use crate::pairs::grid::{virtual_pairs, GridOptions};
 use crate::store::build::kept_triangles;
 use crate::store::BuildStats;
 use crate::IndexedMesh;
@@ -175,9 +183,9 @@ pub(super) struct PassEngine {
     /// The pass in which each vertex last moved or was removed.
     moved_in: Vec<u32>,
     pass: u32,
-    /// The live triangles around each vertex: `incident[first[v]..first[v + 1]]`.
-    first: Vec<u32>,
-    incident: Vec<u32>,
+    /// The live triangles around each vertex: rebuilt at each pass in the pass-based
+    /// order, merged at each contraction in the greedy order.
+    incidence: Incidence,
     candidates: Vec<Candidate>,
     /// Scratch of the batch selection: the batch's candidate indices, the cheapest at
     /// each vertex, and the selected edges.
@@ -202,25 +210,13 @@ pub(super) struct PassEngine {
     /// per vertex the chunk in which it last moved or was removed.
     chunk: u32,
     moved_in_chunk: Vec<u32>,
-    /// Whether chunks may be speculated: off only in tests, which compare the outputs
-    /// with and without.
-    speculate_chunks: bool,
     /// The pairs attempted and contracted since the last chunk began (for
     /// `speculating`).
     chunk_attempted: usize,
     chunk_contracted: usize,
-    /// How many moved faces' orientation verdicts were taken from a speculation, and
-    /// how many asked again because a corner had moved since (for tests).
-    verdicts_reused: usize,
-    verdicts_asked_again: usize,
-    /// How many pairs the blocks of [`super::pass_blocks`] contracted, and how many
-    /// they left to the sequential attempts (for tests).
-    block_contractions: usize,
-    block_deferrals: usize,
-    /// Tests only: instead of the blocks, attempt a round's interior pairs and then
-    /// the others in order, all by the sequential attempts (the order the blocks must
-    /// give the result of; see `interior_first`).
-    blocks_in_order: bool,
+    /// What the tests of speculation and blocks set and read (test builds only).
+    #[cfg(test)]
+    probes: Probes,
     since_report: usize,
     /// The input surface for the orientation check; `None` when the check is off.
     input_surface: Option<InputSurface>,
@@ -235,6 +231,11 @@ pub(super) struct PassEngine {
     block_triangles: Vec<u32>,
     /// Scratch: the pairs of a round the blocks left to the sequential attempts.
     deferred: Vec<u32>,
+    /// The greedy order's pairs and queue (empty in the pass-based order).
+    greedy: greedy::Greedy,
+    /// The virtual pairs not yet contracted (`None` without them; the greedy order
+    /// takes them into its own pairs).
+    virtual_pairs: Option<PairSet>,
 }
 
 /// A [`Fixed`] borrowing the fields of the engine `$engine`, with the orientation
@@ -245,12 +246,12 @@ macro_rules! fixed_of {
         Fixed {
             frame: &$engine.frame,
             settings: &$engine.settings,
-            first: &$engine.first,
-            incident: &$engine.incident,
+            incidence: &$engine.incidence,
             original_normals: &$engine.original_normals,
             vertex_from: &$engine.vertex_from,
             pass: $engine.pass,
             exact: $engine.exact.as_ref(),
+            has_virtual_pairs: $engine.virtual_pairs.is_some(),
             nearest: $nearest,
             waivers: &$engine.waivers,
         }
@@ -322,8 +323,7 @@ impl PassEngine {
             original_normals: Vec::new(),
             moved_in: vec![0; n],
             pass: 0,
-            first: Vec::new(),
-            incident: Vec::new(),
+            incidence: Incidence::default(),
             candidates: Vec::new(),
             batch: Vec::new(),
             keys: Vec::new(),
@@ -338,14 +338,10 @@ impl PassEngine {
             around: [Vec::new(), Vec::new()],
             chunk: 0,
             moved_in_chunk: vec![0; n],
-            speculate_chunks: true,
             chunk_attempted: 0,
             chunk_contracted: 0,
-            verdicts_reused: 0,
-            verdicts_asked_again: 0,
-            block_contractions: 0,
-            block_deferrals: 0,
-            blocks_in_order: false,
+            #[cfg(test)]
+            probes: Probes::default(),
             since_report: 0,
             input_surface: None,
             waivers: Waivers::new(n),
@@ -354,6 +350,8 @@ impl PassEngine {
             block_vertices: BLOCK_VERTICES,
             block_triangles: Vec::new(),
             deferred: Vec::new(),
+            greedy: greedy::Greedy::default(),
+            virtual_pairs: None,
         };
         engine.set_block_vertices(BLOCK_VERTICES);
         // The incident lists first: the quadrics are summed along them.
@@ -365,6 +363,7 @@ impl PassEngine {
                 engine.locked[v as usize] = true;
             }
         }
+        engine.find_virtual_pairs(options);
         engine.counters.locked_vertices = engine.locked.iter().filter(|&&l| l).count();
         engine.settings.any_locked = engine.counters.locked_vertices > 0;
         engine
@@ -378,6 +377,46 @@ impl PassEngine {
             .map(|(t, &cleaned_t)| (t, slots[cleaned_t as usize]));
         surface.seed_hints(hints);
         self.input_surface = Some(surface);
+    }
+
+    /// The virtual pairs: vertices closer than the pair threshold and not joined by
+    /// an edge (only between different parts with [`VirtualPairs::BetweenComponents`]),
+    /// at most the nearest few per vertex (see [`GridOptions`]).
+    fn find_virtual_pairs(&mut self, options: &SimplifyOptions) {
+        let threshold = self.settings.virtual_pair_threshold;
+        if threshold.is_nan() || threshold <= 0.0 {
+            return;
+        }
+        let n = self.position.len();
+        let part = (options.virtual_pairs == VirtualPairs::BetweenComponents).then(|| {
+            let mut parent: Vec<usize> = (0..n).collect();
+            for &t in &self.live {
+                let [x, y, z] = self.triangles[t as usize].map(|c| c as usize);
+                union(&mut parent, x, y);
+                union(&mut parent, x, z);
+            }
+            (0..n)
+                .map(|v| find(&mut parent, v) as u32)
+                .collect::<Vec<u32>>()
+        });
+        let points: Vec<[f64; 3]> = self.position.iter().map(|p| p.to_array()).collect();
+        let grid =
+            GridOptions::new(threshold).with_max_per_vertex(options.max_virtual_pairs_per_vertex);
+        let (incidence, triangles) = (&self.incidence, &self.triangles);
+        let found = virtual_pairs(&points, &grid, |i, j| {
+            let separate = part.as_ref().is_none_or(|p| p[i as usize] != p[j as usize]);
+            let joined = || {
+                let (walked, other) = incidence.shorter(i, j);
+                (incidence.of(walked).iter()).any(|&t| triangles[t as usize].contains(&other))
+            };
+            separate && !joined()
+        });
+        self.counters.virtual_pairs = found.pairs.len();
+        self.counters.virtual_pairs_capped = found.capped;
+        if !found.pairs.is_empty() {
+            let ends = found.pairs.into_iter().map(|(i, j)| [i, j]).collect();
+            self.virtual_pairs = Some(PairSet::new(n, ends));
+        }
     }
 
     /// What no contraction of the pass changes, for the shared pieces of an attempt
@@ -492,6 +531,11 @@ impl PassEngine {
                     WaiverChange::Forget(v) => self.waivers.forget(v),
                 }
             }
+            if let Some(pairs) = &mut self.virtual_pairs {
+                for &[kept, removed] in &outcome.merges {
+                    pairs.contract(kept, removed, |_, _| {});
+                }
+            }
             if let Some(exact) = &mut self.exact {
                 for change in &outcome.exact_changes {
                     let collapsed = change.collapsed.iter().copied();
@@ -577,12 +621,12 @@ impl PassEngine {
         // `live` (the order of its incident list): the bits the sum in that order gives,
         // whatever the thread count. (Made from the plane at each corner rather than
         // kept per triangle: 80 bytes a triangle saved.)
-        let (first, incident) = (&self.first, &self.incident);
-        self.quadric = (0..self.position.len())
+        let incidence = &self.incidence;
+        self.quadric = (0..self.position.len() as u32)
             .into_par_iter()
             .map(|v| {
                 let mut sum = Quadric::default();
-                for &t in &incident[first[v] as usize..first[v + 1] as usize] {
+                for &t in incidence.of(v) {
                     sum += planes[t as usize].quadric();
                 }
                 sum
@@ -600,36 +644,17 @@ impl PassEngine {
     /// Lists the live triangles around every vertex, each vertex's in increasing
     /// triangle order (a counting sort of the live triangles' corners).
     fn list_incident_triangles(&mut self) {
-        let n = self.position.len();
-        self.first.clear();
-        self.first.resize(n + 1, 0);
-        for &t in &self.live {
-            for c in self.triangles[t as usize] {
-                self.first[c as usize + 1] += 1;
-            }
-        }
-        for v in 0..n {
-            self.first[v + 1] += self.first[v];
-        }
-        self.incident.clear();
-        self.incident.resize(self.live.len() * 3, 0);
-        // `seen_with` doubles as the fill cursor here; `list_edges` resets it.
-        self.seen_with.clear();
-        self.seen_with.extend_from_slice(&self.first[..n]);
-        for &t in &self.live {
-            for c in self.triangles[t as usize] {
-                let slot = &mut self.seen_with[c as usize];
-                self.incident[*slot as usize] = t;
-                *slot += 1;
-            }
-        }
+        let (live, triangles) = (&self.live, &self.triangles);
+        self.incidence.rebuild(self.position.len(), || {
+            live.iter()
+                .flat_map(move |&t| triangles[t as usize].map(move |c| (c, t)))
+        });
     }
 
     /// The live triangles around `v`, with their current corners, into `out`.
     fn gather(&self, v: u32, out: &mut Vec<Around>) {
         out.clear();
-        let range = self.first[v as usize] as usize..self.first[v as usize + 1] as usize;
-        for &t in &self.incident[range] {
+        for &t in self.incidence.of(v) {
             let corners = self.triangles[t as usize];
             if corners[0] != REMOVED {
                 out.push(Around {
@@ -797,7 +822,12 @@ impl PassEngine {
             // thread pool; the others follow in order (see `pass_blocks`). Each
             // interior contraction removes at most two triangles, so the target
             // cannot be passed among them.
-            let attempts = if !may_reach_target && self.uses_blocks() && self.blocks_in_order {
+            #[cfg(test)]
+            let blocks_in_order = self.probes.blocks_in_order;
+            #[cfg(not(test))]
+            let blocks_in_order = false;
+            let attempts = if !may_reach_target && self.uses_blocks() && blocks_in_order {
+                #[cfg(test)]
                 self.interior_first(&selected, &mut deferred);
                 &deferred
             } else if !may_reach_target && self.uses_blocks() {
@@ -805,8 +835,11 @@ impl PassEngine {
                 live_count -= blocks.removed;
                 contracted += blocks.contracted;
                 waived += blocks.waived;
-                self.block_contractions += blocks.contracted;
-                self.block_deferrals += deferred.len();
+                #[cfg(test)]
+                {
+                    self.probes.block_contractions += blocks.contracted;
+                    self.probes.block_deferrals += deferred.len();
+                }
                 over_bound |= blocks.over_bound;
                 if self.count_attempts(blocks.attempted, [live_count, start, target], observer) {
                     end = Some(PassEnd::Cancelled);
@@ -837,13 +870,13 @@ impl PassEngine {
                     .get(k % SPECULATION_CHUNK)
                     .and_then(Option::as_ref);
                 let Candidate { a, b, .. } = self.candidates[i as usize];
-                match self.try_contract(a, b, live_count, speculation, observer) {
-                    Attempt::Contracted { removed } => {
+                match self.try_contract(a, b, live_count, true, speculation, observer) {
+                    Attempt::Contracted { removed, .. } => {
                         live_count -= removed;
                         contracted += 1;
                         self.chunk_contracted += 1;
                     }
-                    Attempt::Refused => {}
+                    Attempt::Refused | Attempt::NotAPair => {}
                     Attempt::Waived => waived += 1,
                     // Never contracted; the pass goes on with the pairs under the bound.
                     Attempt::OverErrorBound => over_bound = true,
@@ -971,10 +1004,23 @@ impl PassEngine {
         self.listed_first.clear();
         for v in 0..self.position.len() as u32 {
             self.listed_first.push(self.candidates.len() as u32);
-            let range = self.first[v as usize] as usize..self.first[v as usize + 1] as usize;
-            for &t in &self.incident[range] {
+            for &t in self.incidence.of(v) {
                 for c in self.triangles[t as usize] {
                     if c > v && self.seen_with[c as usize] != v {
+                        self.seen_with[c as usize] = v;
+                        self.candidates.push(Candidate {
+                            a: v,
+                            b: c,
+                            cost: 0.0,
+                        });
+                    }
+                }
+            }
+            // Then its virtual pairs that are not edges (yet), each once.
+            if let Some(pairs) = &self.virtual_pairs {
+                for &id in pairs.of(v) {
+                    let [x, c] = pairs.ends(id);
+                    if x == v && self.seen_with[c as usize] != v {
                         self.seen_with[c as usize] = v;
                         self.candidates.push(Candidate {
                             a: v,
@@ -1073,29 +1119,45 @@ impl PassEngine {
     /// `Q_ab` of exact quadrics for `a` and `b` ([`shared_planes`]).
     fn shared_planes(&self, exact: &PassExact, a: u32, b: u32) -> Quadric {
         let triangles = (0, &self.triangles[..]);
-        shared_planes(&self.first, &self.incident, triangles, exact, [a, b])
+        shared_planes(&self.incidence, triangles, exact, [a, b])
     }
 
     /// Checks and contracts the edge `a b` (both unmoved in this pass); `live` is the
     /// live triangle count.
     ///
     /// `speculation` is what [`speculate`](Self::speculate) found for the pair.
+    ///
+    /// A pair on no common triangle is a virtual pair: attempted only when
+    /// `virtual_allowed` (the greedy order's edges that lost their last triangle are
+    /// not).
     fn try_contract(
         &mut self,
         a: u32,
         b: u32,
         live: usize,
+        virtual_allowed: bool,
         speculation: Option<&Speculation>,
         observer: &mut dyn Observer,
     ) -> Attempt {
-        let Some((a, b)) = self.kept_first(a, b) else {
-            self.counters.reject(Rejection::Locked);
-            return Attempt::Refused;
-        };
         let mut around = std::mem::take(&mut self.around);
         self.gather(a, &mut around[0]);
         self.gather(b, &mut around[1]);
         let shared = around[0].iter().filter(|x| x.corners.contains(&b)).count();
+        if shared == 0 && !virtual_allowed {
+            self.around = around;
+            return Attempt::NotAPair;
+        }
+        let Some((kept, _)) = self.kept_first(a, b) else {
+            self.around = around;
+            self.counters.reject(Rejection::Locked);
+            return Attempt::Refused;
+        };
+        let (a, b) = if kept == a {
+            (a, b)
+        } else {
+            around.swap(0, 1);
+            (b, a)
+        };
         // Never contract the last faces away: the output must keep a triangle.
         let attempt = if shared >= live {
             Attempt::Refused
@@ -1186,9 +1248,11 @@ impl PassEngine {
     /// longer still with those checks asked first in the speculation. The rule changes
     /// only the work: the outputs are the same either way.
     fn speculating(&self) -> bool {
-        self.input_surface.is_some()
-            && self.speculate_chunks
-            && self.chunk_contracted * 2 >= self.chunk_attempted
+        #[cfg(test)]
+        if !self.probes.speculate_chunks {
+            return false;
+        }
+        self.input_surface.is_some() && self.chunk_contracted * 2 >= self.chunk_attempted
     }
 
     /// [`speculate`](Self::speculate) for one pair; `around` is scratch.
@@ -1299,19 +1363,32 @@ impl PassEngine {
                 }),
             );
         }
+        if let Some(pairs) = &mut self.virtual_pairs {
+            pairs.contract(a, b, |_, _| {});
+        }
         let (mut slab, fixed) = self.split();
         let removed = slab.contract(&fixed, [a, b], world, q, around);
-        self.counters.edge_contractions += 1;
+        let is_virtual = shared == 0;
+        if is_virtual {
+            self.counters.virtual_contractions += 1;
+        } else {
+            self.counters.edge_contractions += 1;
+        }
         self.counters.max_error = self.counters.max_error.max(error);
         observer.contracted(&Contraction {
             kept: self.vertex_from[a as usize],
             removed: self.vertex_from[b as usize],
-            is_virtual: false,
+            is_virtual,
             quadric: q,
             position: placed.position,
+            world: world.to_array(),
             cost: placed.cost,
         });
-        Attempt::Contracted { removed }
+        Attempt::Contracted {
+            removed,
+            kept: a,
+            gone: b,
+        }
     }
 
     /// Every check of contracting `b` into `a` at `world`, the greedy loop's rules on
@@ -1360,7 +1437,7 @@ impl PassEngine {
         };
         let known = speculation.map_or(&[][..], |s| &s.faces[..]);
         let (chunk, moved_in_chunk) = (self.chunk, &self.moved_in_chunk);
-        let (reused, asked_again) = (&mut self.verdicts_reused, &mut self.verdicts_asked_again);
+        let (mut reused, mut asked_again) = (0, 0);
         let still_holds = |x: &Around| {
             x.corners
                 .iter()
@@ -1374,21 +1451,29 @@ impl PassEngine {
         let moved = self.frame.to_normalized(world);
         // A triangle seen for the first time borrows the hint of the one checked before.
         let mut neighbour_hint = None;
-        around.iter().flatten().all(|x| {
+        let agrees = around.iter().flatten().all(|x| {
             let corners = x.corners;
             if corners.contains(&a) && corners.contains(&b) {
                 return true;
             }
             if known.iter().any(|f| f.triangle == x.triangle) {
                 if still_holds(x) {
-                    *reused += 1;
+                    reused += 1;
                     return true;
                 }
-                *asked_again += 1;
+                asked_again += 1;
             }
             let new = moved_corners(&self.position, corners, [a, b], moved);
             surface.agrees(x.triangle as usize, new, &mut neighbour_hint)
-        })
+        });
+        #[cfg(test)]
+        {
+            self.probes.verdicts_reused += reused;
+            self.probes.verdicts_asked_again += asked_again;
+        }
+        #[cfg(not(test))]
+        let _ = (reused, asked_again);
+        agrees
     }
 
     /// Whether contracting `b` into `a` would leave a locked vertex without a triangle:
@@ -1429,11 +1514,12 @@ impl PassEngine {
         false
     }
 
-    /// Tests only: `selected` (a round, in list order) into `order` with the pairs
+    /// `selected` (a round, in list order) into `order` with the pairs
     /// interior to their block first, then the others, each in list order; found here
     /// independently of [`Slab::gather`], at the round's start (a contraction inside a
     /// block keeps its triangles' corners in the block, so a pair's standing cannot
     /// change during the round).
+    #[cfg(test)]
     fn interior_first(&self, selected: &[u32], order: &mut Vec<u32>) {
         let layout_block = |v: u32| v / self.block_vertices;
         let n = self.position.len() as u32;
@@ -1444,8 +1530,7 @@ impl PassEngine {
             let triangles = self.block_triangles[k as usize]..self.block_triangles[k as usize + 1];
             let mut shared = 0;
             for v in [a, b] {
-                let range = self.first[v as usize] as usize..self.first[v as usize + 1] as usize;
-                for &t in &self.incident[range] {
+                for &t in self.incidence.of(v) {
                     if !triangles.contains(&t) {
                         return false;
                     }
@@ -1529,9 +1614,13 @@ impl PassEngine {
 }
 
 /// What [`PassEngine::try_contract`] did.
-enum Attempt {
-    /// Contracted, removing this many triangles.
-    Contracted { removed: usize },
+pub(super) enum Attempt {
+    /// Contracted `gone` into `kept`, removing `removed` triangles.
+    Contracted {
+        removed: usize,
+        kept: u32,
+        gone: u32,
+    },
     /// Refused by a check (counted) or to keep the last triangles.
     Refused,
     /// Refused by the orientation check (counted), and waived: ranked at a penalty
@@ -1539,6 +1628,8 @@ enum Attempt {
     Waived,
     /// The pair's error is above the bound: not contracted.
     OverErrorBound,
+    /// Not attempted: the ends share no triangle, and virtual pairs were not allowed.
+    NotAPair,
 }
 
 /// What [`PassEngine::speculate`] found for a pair, in the order it is contracted.
@@ -1560,6 +1651,40 @@ struct FaceAgrees {
     settled: Option<u32>,
 }
 
+/// What the tests of speculation and blocks set and read on a run (test builds only:
+/// release builds have neither the switches nor the counts).
+#[cfg(test)]
+#[derive(Debug)]
+struct Probes {
+    /// Whether chunks may be speculated (the tests compare outputs with and without).
+    speculate_chunks: bool,
+    /// Instead of the blocks, attempt a round's interior pairs and then the others in
+    /// order, all by the sequential attempts (the order the blocks must give the
+    /// result of; see `interior_first`).
+    blocks_in_order: bool,
+    /// Moved faces' orientation verdicts taken from a speculation, and asked again
+    /// because a corner had moved since.
+    verdicts_reused: usize,
+    verdicts_asked_again: usize,
+    /// Pairs the blocks contracted, and left to the sequential attempts.
+    block_contractions: usize,
+    block_deferrals: usize,
+}
+
+#[cfg(test)]
+impl Default for Probes {
+    fn default() -> Self {
+        Probes {
+            speculate_chunks: true,
+            blocks_in_order: false,
+            verdicts_reused: 0,
+            verdicts_asked_again: 0,
+            block_contractions: 0,
+            block_deferrals: 0,
+        }
+    }
+}
+
 /// The positions of a triangle's `corners` once the pair `ends` is contracted to
 /// `moved` (normalised units): either end goes to `moved`, the others stay.
 fn moved_corners(
@@ -1576,6 +1701,9 @@ fn moved_corners(
         }
     })
 }
+
+#[path = "greedy.rs"]
+mod greedy;
 
 #[cfg(test)]
 #[path = "passes_speculation_tests.rs"]

@@ -103,11 +103,11 @@ pub(super) fn run_levels(
             let (surface, slots) = InputSurface::new(&cleaned.mesh, &frame);
             engine.set_input_surface(surface, &slots);
         }
-        engine.speculate_chunks = setup.speculation;
+        engine.probes.speculate_chunks = setup.speculation;
         if let Some(block_vertices) = setup.block_vertices {
             engine.set_block_vertices(block_vertices);
         }
-        engine.blocks_in_order = setup.blocks_in_order;
+        engine.probes.blocks_in_order = setup.blocks_in_order;
         let mut levels = Vec::new();
         for &target in targets {
             let reason = engine.run(target, &mut NoObserver);
@@ -127,11 +127,11 @@ pub(super) fn run_levels(
             }
         }
         let seen = Seen {
-            reused: engine.verdicts_reused,
-            asked_again: engine.verdicts_asked_again,
+            reused: engine.probes.verdicts_reused,
+            asked_again: engine.probes.verdicts_asked_again,
             refused: engine.counters.rejected_orientation,
-            block_contractions: engine.block_contractions,
-            block_deferrals: engine.block_deferrals,
+            block_contractions: engine.probes.block_contractions,
+            block_deferrals: engine.probes.block_deferrals,
         };
         (levels, seen)
     })

@@ -1,7 +1,6 @@
 //! What a run did ([`SimplifyReport`]), why it stopped, and why it could not run.
 
 use crate::clean::CleanReport;
-use crate::store::StoreError;
 use crate::{IndexedMesh, InputError};
 use std::fmt;
 use std::time::Duration;
@@ -160,16 +159,6 @@ pub enum SimplifyError {
         /// How many vertices the input has.
         vertex_count: usize,
     },
-    /// An option that [`ContractionOrder::Passes`](super::ContractionOrder::Passes)
-    /// does not implement was asked for with it.
-    NotInPasses {
-        /// The option, as the field of [`SimplifyOptions`](super::SimplifyOptions)
-        /// and its value (for example `"preserve_topology = true"`).
-        option: &'static str,
-    },
-    /// A bug: the store broke an invariant (only detected with
-    /// [`SimplifyOptions::validate_each_contraction`](super::SimplifyOptions::validate_each_contraction)).
-    Internal(StoreError),
 }
 
 impl fmt::Display for SimplifyError {
@@ -189,12 +178,6 @@ impl fmt::Display for SimplifyError {
                 "locked vertex {index} is out of range: the input has {vertex_count} \
                  vertices (indices start at 0)"
             ),
-            SimplifyError::NotInPasses { option } => write!(
-                f,
-                "{option} is not available in the pass-based order (ContractionOrder::Passes); \
-                 start from SimplifyOptions::FAST, or use the greedy order"
-            ),
-            SimplifyError::Internal(e) => write!(f, "internal error, please report: {e}"),
         }
     }
 }

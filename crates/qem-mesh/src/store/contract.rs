@@ -188,31 +188,6 @@ impl MeshStore {
         Ok(self.contract_checked(a, b, ab, position, Some(log)))
     }
 
-    /// [`contract`](Self::contract) (or [`contract_logged`](Self::contract_logged) when
-    /// `log` is given) for a caller that already looked up the edge `ab` joining `a`
-    /// and `b` (`None` for a virtual pair). Why: the simplifier needs that edge for its
-    /// checks, and a second search of the smaller star per contraction is measurable.
-    ///
-    /// `ab` must be `self.find_edge(a, b)` (checked in debug builds).
-    ///
-    /// # Errors
-    /// As [`contract`](Self::contract).
-    pub(crate) fn contract_along(
-        &mut self,
-        a: VertexKey,
-        b: VertexKey,
-        ab: Option<EdgeKey>,
-        position: [f64; 3],
-        mut log: Option<&mut ContractLog>,
-    ) -> Result<ContractOutcome, ContractError> {
-        if let Some(log) = log.as_deref_mut() {
-            log.clear();
-        }
-        self.check_contract(a, b, position)?;
-        debug_assert_eq!(ab, self.find_edge(a, b));
-        Ok(self.contract_checked(a, b, ab, position, log))
-    }
-
     /// The refusals of [`contract`](Self::contract): same vertex, dead key, non-finite
     /// position.
     fn check_contract(

@@ -56,14 +56,12 @@ mod compact;
 mod contract;
 mod fan;
 mod query;
-mod slot_vec;
 mod validate;
 
 pub use build::BuildStats;
 pub use contract::{ContractError, ContractLog, ContractOutcome};
 use fan::{Fan, FanPool};
 pub use query::{EdgeClass, VertexClass};
-pub(crate) use slot_vec::{slot_index, SlotVec};
 pub use validate::StoreError;
 
 slotmap::new_key_type! {

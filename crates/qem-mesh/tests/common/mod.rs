@@ -266,3 +266,19 @@ pub fn holed_grid() -> IndexedMesh {
         .collect();
     IndexedMesh::new(g.positions, triangles)
 }
+
+/// [`simplify`](qem_mesh::simplify::simplify) with every contraction replayed on the
+/// store ([`StoreReplay`](qem_mesh::simplify::StoreReplay)): panics when the store breaks
+/// or ends unlike the output.
+#[allow(dead_code)] // not every test file uses every helper
+pub fn simplify_replayed(
+    mesh: &IndexedMesh,
+    options: &qem_mesh::simplify::SimplifyOptions,
+) -> Result<qem_mesh::simplify::Simplified, qem_mesh::simplify::SimplifyError> {
+    let mut replay = qem_mesh::simplify::StoreReplay::default();
+    let out = qem_mesh::simplify::simplify_observed(mesh, options, &mut replay)?;
+    if let Err(e) = replay.check_output(&out.mesh) {
+        panic!("the store disagrees with the engine: {e}");
+    }
+    Ok(out)
+}

@@ -1,0 +1,137 @@
+//! The engine's oracle: an [`Observer`] that replays every contraction of a run on the
+//! radial-edge store ([`MeshStore`]), the library's model of non-manifold input, and
+//! checks that the store stays valid and that both describe the same mesh.
+//!
+//! The engine works on flat arrays and never builds the store; the store contracts by
+//! its own rules (faces on both ends collapse, the other faces of the removed vertex
+//! move to the kept one, faces that would coincide merge). Replaying the engine's
+//! contractions, in order, on a store built from the cleaned mesh must give the
+//! engine's output: any difference is a bug in one of the two. Tests and fuzz targets
+//! run it; it costs a validation of the whole store per contraction, so it is for
+//! small meshes.
+
+use super::observer::{Contraction, Observer};
+use crate::store::{MeshStore, VertexKey};
+use crate::IndexedMesh;
+use qem_core::Frame;
+
+/// Replays a run's contractions on a [`MeshStore`] (see the module's doc).
+///
+/// ```
+/// use qem_mesh::simplify::{simplify_observed, SimplifyOptions, StoreReplay, Target};
+/// use qem_mesh::IndexedMesh;
+/// // A square pyramid without its base.
+/// let mesh = IndexedMesh::new(
+///     vec![[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]],
+///     vec![[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1]],
+/// );
+/// let mut replay = StoreReplay::default();
+/// let options = SimplifyOptions::DEFAULT.with_target(Target::Triangles(2));
+/// let out = simplify_observed(&mesh, &options, &mut replay)?;
+/// replay.check_output(&out.mesh).map_err(|e| e.to_string())?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Debug, Default)]
+pub struct StoreReplay {
+    store: Option<MeshStore>,
+    keys: Vec<VertexKey>,
+    /// The first disagreement, if any.
+    failure: Option<String>,
+    contractions: usize,
+}
+
+impl StoreReplay {
+    /// The number of contractions replayed.
+    pub fn contractions(&self) -> usize {
+        self.contractions
+    }
+
+    /// `Ok` when every contraction replayed on a valid store, and the store's faces
+    /// are `output`'s triangles (as corner positions, same orientation, in any order
+    /// and rotation); otherwise what differed first.
+    pub fn check_output(&self, output: &IndexedMesh) -> Result<(), String> {
+        if let Some(failure) = &self.failure {
+            return Err(failure.clone());
+        }
+        let Some(store) = &self.store else {
+            return Err("the run reported no cleaned mesh".to_string());
+        };
+        let mut from_store: Vec<[[u64; 3]; 3]> = store
+            .faces()
+            .map(|f| canonical(store.face_vertices(f).map(|v| store.position(v))))
+            .collect();
+        let mut from_output: Vec<[[u64; 3]; 3]> = output
+            .triangles
+            .iter()
+            .map(|t| canonical(t.map(|i| output.positions[i as usize])))
+            .collect();
+        from_store.sort_unstable();
+        from_output.sort_unstable();
+        if from_store != from_output {
+            let only_store = from_store
+                .iter()
+                .filter(|t| !from_output.contains(t))
+                .count();
+            let only_output = from_output
+                .iter()
+                .filter(|t| !from_store.contains(t))
+                .count();
+            return Err(format!(
+                "the store holds {} faces and the output {} triangles; {only_store} only \
+                 in the store, {only_output} only in the output",
+                from_store.len(),
+                from_output.len()
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// A triangle as the bits of its corners, rotated so that the smallest comes first
+/// (orientation kept).
+fn canonical(corners: [[f64; 3]; 3]) -> [[u64; 3]; 3] {
+    let bits = corners.map(|c| c.map(f64::to_bits));
+    let first = (0..3).min_by_key(|&i| bits[i]).unwrap_or(0);
+    [bits[first], bits[(first + 1) % 3], bits[(first + 2) % 3]]
+}
+
+impl Observer for StoreReplay {
+    fn cleaned(&mut self, mesh: &IndexedMesh, _frame: &Frame) {
+        match MeshStore::from_mesh(mesh) {
+            Ok((store, keys)) => {
+                self.store = Some(store);
+                self.keys = keys;
+            }
+            Err(e) => self.failure = Some(format!("the store refused the cleaned mesh: {e}")),
+        }
+    }
+
+    fn contracted(&mut self, c: &Contraction) {
+        if self.failure.is_some() {
+            return;
+        }
+        let Some(store) = &mut self.store else {
+            self.failure = Some("a contraction before the cleaned mesh".to_string());
+            return;
+        };
+        let (Some(&a), Some(&b)) = (
+            self.keys.get(c.kept as usize),
+            self.keys.get(c.removed as usize),
+        ) else {
+            self.failure = Some(format!("contraction {}: no such vertex", self.contractions));
+            return;
+        };
+        let step = self.contractions;
+        self.contractions += 1;
+        if let Err(e) = store.contract(a, b, c.world) {
+            self.failure = Some(format!(
+                "contraction {step} ({} into {}): the store refused it: {e}",
+                c.removed, c.kept
+            ));
+            return;
+        }
+        if let Err(e) = store.validate() {
+            self.failure = Some(format!("contraction {step}: the store broke: {e}"));
+        }
+    }
+}
