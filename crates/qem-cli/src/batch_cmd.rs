@@ -161,7 +161,7 @@ pub fn run(args: &BatchArgs) -> Result<(), Failure> {
             Ok(json) => {
                 triangles_in += json.triangles_in();
                 triangles_out += json.triangles_out();
-                entries.push(BatchEntry::Done(json));
+                entries.push(BatchEntry::Done(Box::new(json)));
             }
             Err(error) => {
                 failures.push(error.clone());

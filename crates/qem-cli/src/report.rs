@@ -1,6 +1,7 @@
 //! JSON reports, written atomically. Field names are the documented JSON keys.
 
 use qem_mesh::inspect::MeshInfo;
+use qem_mesh::io::ReadNotes;
 use qem_mesh::simplify::SimplifyReport;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -40,7 +41,30 @@ pub struct SimplifyJson {
     /// Output faces whose normal points away from their input face (0 unless the
     /// fold-over check is off).
     faces_flipped: usize,
+    /// What the reader passed over (issue 33): `skipped_lines`, `skipped_properties`,
+    /// `non_utf8_lines`, `byte_order_mark`.
+    read_notes: ReadNotesJson,
     timings_ms: BTreeMap<&'static str, f64>,
+}
+
+/// [`ReadNotes`] as JSON.
+#[derive(Serialize, Debug, Clone, Copy, Default)]
+pub struct ReadNotesJson {
+    skipped_lines: usize,
+    skipped_properties: usize,
+    non_utf8_lines: usize,
+    byte_order_mark: bool,
+}
+
+impl From<ReadNotes> for ReadNotesJson {
+    fn from(n: ReadNotes) -> Self {
+        ReadNotesJson {
+            skipped_lines: n.skipped_lines,
+            skipped_properties: n.skipped_properties,
+            non_utf8_lines: n.non_utf8_lines,
+            byte_order_mark: n.byte_order_mark,
+        }
+    }
 }
 
 fn ms(d: Duration) -> f64 {
@@ -48,11 +72,13 @@ fn ms(d: Duration) -> f64 {
 }
 
 impl SimplifyJson {
-    /// Collects the report of a run with its file names and the CLI's own timings.
+    /// Collects the report of a run with its file names, what the reader passed over
+    /// and the CLI's own timings.
     pub fn new(
         input: &Path,
         output: &Path,
         r: &SimplifyReport,
+        notes: ReadNotes,
         load: Duration,
         simplify: Duration,
         write: Duration,
@@ -107,6 +133,7 @@ impl SimplifyJson {
             ]),
             locked_vertices: r.locked_vertices,
             faces_flipped: r.faces_flipped,
+            read_notes: notes.into(),
             timings_ms,
         }
     }
@@ -164,7 +191,7 @@ pub struct LevelsJson {
 #[serde(untagged)]
 pub enum BatchEntry {
     /// The file was simplified and written.
-    Done(SimplifyJson),
+    Done(Box<SimplifyJson>),
     /// The file failed; nothing was written for it.
     Failed {
         /// The input file.

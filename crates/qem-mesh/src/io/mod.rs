@@ -162,8 +162,56 @@ fn strip_gz(name: &str) -> Option<&str> {
 pub struct LoadedMesh {
     /// The triangles and positions; passes [`IndexedMesh::validate`].
     pub mesh: IndexedMesh,
-    /// Texture coordinates and normals of an OBJ file (`None` for other formats).
+    /// Texture coordinates, normals and names of an OBJ file (`None` for other formats).
     pub obj: Option<ObjAttributes>,
+    /// What the reader passed over without using it.
+    pub notes: ReadNotes,
+}
+
+/// What a reader passed over: parts of the file that carry nothing qem uses.
+///
+/// The readers are lenient where a format gives bytes no meaning for the geometry
+/// (names, comments, unknown keywords and properties) and strict where it does (a
+/// malformed number is an error naming its line). These counts say how much was passed
+/// over, so a report can show it; none of it changes the mesh.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct ReadNotes {
+    /// Lines skipped as unknown or unused: OBJ lines other than `v`, `vt`, `vn`, `f`,
+    /// `o`, `g`, `usemtl`, `mtllib`, comments and blank lines (so `l`, `p`, `s`, `vp`,
+    /// curve and surface statements, and unknown keywords); PLY header lines with a
+    /// keyword the format does not define; ASCII STL lines holding a word outside STL's
+    /// grammar; OFF lines after the last face. Default 0.
+    pub skipped_lines: usize,
+    /// PLY properties the reader does not use, counted once per declaration in the
+    /// header: everything but `x`, `y`, `z` of the vertex element and the index list of
+    /// the face element (colours, normals, texture coordinates, properties of other
+    /// elements). Default 0.
+    pub skipped_properties: usize,
+    /// Text lines holding bytes that are not UTF-8 (in names and comments; Latin-1
+    /// material names are common), read as bytes. Default 0.
+    pub non_utf8_lines: usize,
+    /// Whether the data began with a UTF-8 byte order mark (`EF BB BF`), which was
+    /// skipped. Default `false`.
+    pub byte_order_mark: bool,
+}
+
+impl ReadNotes {
+    /// Whether the reader passed over anything at all.
+    pub fn is_empty(&self) -> bool {
+        *self == ReadNotes::default()
+    }
+}
+
+/// The UTF-8 byte order mark some Windows tools put before text.
+const BOM: &[u8] = b"\xEF\xBB\xBF";
+
+/// `bytes` without a leading UTF-8 byte order mark, and whether there was one.
+pub(crate) fn strip_bom(bytes: &[u8]) -> (&[u8], bool) {
+    match bytes.strip_prefix(BOM) {
+        Some(rest) => (rest, true),
+        None => (bytes, false),
+    }
 }
 
 /// Reads mesh data in `format` from memory. Gzip data (magic bytes `1f 8b`) is
@@ -193,21 +241,26 @@ fn read_plain(bytes: &[u8], format: Format) -> Result<LoadedMesh, ReadError> {
     if bytes.is_empty() {
         return Err(ReadError::new(ReadErrorKind::Empty, None));
     }
-    let loaded = match format {
-        Format::Obj => obj::read(bytes)?,
-        Format::Ply => LoadedMesh {
-            mesh: ply::read(bytes)?,
-            obj: None,
-        },
-        Format::Stl => LoadedMesh {
-            mesh: stl::read(bytes)?,
-            obj: None,
-        },
-        Format::Off => LoadedMesh {
-            mesh: off::read(bytes)?,
-            obj: None,
-        },
+    let mut notes = ReadNotes::default();
+    // A byte order mark is text's; binary STL's 80-byte header may start with any
+    // bytes, so the STL reader decides for itself once it knows which form it reads.
+    let text = if format == Format::Stl {
+        bytes
+    } else {
+        let (rest, bom) = strip_bom(bytes);
+        notes.byte_order_mark = bom;
+        rest
     };
+    let (mesh, obj) = match format {
+        Format::Obj => {
+            let (mesh, attrs) = obj::read(text, &mut notes)?;
+            (mesh, Some(attrs))
+        }
+        Format::Ply => (ply::read(text, &mut notes)?, None),
+        Format::Stl => (stl::read(text, &mut notes)?, None),
+        Format::Off => (off::read(text, &mut notes)?, None),
+    };
+    let loaded = LoadedMesh { mesh, obj, notes };
     // The parsers report most problems with a place; this is the safety net that makes
     // the documented guarantee hold whatever they missed.
     loaded
