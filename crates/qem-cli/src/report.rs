@@ -192,6 +192,9 @@ pub struct LevelsJson {
 pub enum BatchEntry {
     /// The file was simplified and written.
     Done(Box<SimplifyJson>),
+    /// An earlier run simplified and wrote it (`--resume`): that run's report, with
+    /// `"resumed": true` added.
+    Resumed(serde_json::Value),
     /// The file failed; nothing was written for it.
     Failed {
         /// The input file.
@@ -208,21 +211,26 @@ pub enum BatchEntry {
 pub struct BatchSummary {
     /// Inputs found (files named, matched by globs, found in directories).
     pub inputs: usize,
-    /// Inputs simplified and written.
+    /// Inputs simplified and written, by this run or (with `--resume`) an earlier one.
     pub succeeded: usize,
+    /// Of `succeeded`, the inputs an earlier run completed (`--resume`).
+    pub resumed: usize,
     /// Inputs that failed (or were not started because of Ctrl-C).
     pub failed: usize,
     /// Whether Ctrl-C stopped the run.
     pub interrupted: bool,
     /// Worker threads.
     pub jobs: usize,
+    /// Temporary files of killed runs removed from the output directories.
+    pub stale_temporaries_removed: usize,
     /// Triangles of the succeeded inputs, as loaded.
     pub triangles_in: usize,
     /// Triangles written.
     pub triangles_out: usize,
     /// Wall time of the whole run, from the first load to the last write.
     pub wall_ms: f64,
-    /// `triangles_in` per second of `wall_ms`.
+    /// Input triangles simplified by this run (not the resumed ones) per second of
+    /// `wall_ms`.
     pub input_triangles_per_second: f64,
 }
 
@@ -282,17 +290,14 @@ impl InfoJson {
 }
 
 /// Writes `value` as pretty JSON to `path` through a temporary file in the same
-/// directory, so a failure never leaves a partial report.
+/// directory (qem's own, so a killed run's is cleaned up by the next), so a failure
+/// never leaves a partial report.
 pub fn write_json_atomically(path: &Path, value: &impl Serialize) -> Result<(), String> {
-    let fail =
-        |e: &dyn std::fmt::Display| format!("{}: cannot write the report: {e}", path.display());
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(|e| fail(&e))?;
-    serde_json::to_writer_pretty(&mut tmp, value).map_err(|e| fail(&e))?;
-    tmp.write_all(b"\n").map_err(|e| fail(&e))?;
-    tmp.persist(path).map_err(|e| fail(&e.error))?;
-    Ok(())
+    qem_mesh::io::write_atomically(path, |file| {
+        let mut out = std::io::BufWriter::new(file);
+        serde_json::to_writer_pretty(&mut out, value)?;
+        out.write_all(b"\n")?;
+        out.flush()
+    })
+    .map_err(|e| e.to_string())
 }

@@ -46,6 +46,7 @@
 //! assert_eq!(loaded.mesh, mesh);
 //! ```
 
+mod atomic;
 mod error;
 pub mod obj;
 mod off;
@@ -54,8 +55,12 @@ mod stl;
 mod text;
 
 use std::io::{Read, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
+pub use atomic::{
+    remove_stale_temporaries, temporary_owner, write_atomically, STALE_AGE_WITHOUT_PROC,
+    TEMP_MARKER,
+};
 pub use error::{IoError, Location, ReadError, ReadErrorKind};
 pub use obj::ObjAttributes;
 
@@ -367,7 +372,8 @@ pub fn write_to<W: Write>(out: W, mesh: &IndexedMesh, format: Format) -> std::io
 ///
 /// The data goes to a new temporary file in the same directory, which is flushed to
 /// disk and then renamed over `path`; on any error the temporary file is removed, so
-/// `path` either keeps its old content or gets the complete new one.
+/// `path` either keeps its old content or gets the complete new one
+/// ([`write_atomically`]).
 pub fn write_path(path: &Path, mesh: &IndexedMesh) -> Result<(), IoError> {
     let format = Format::from_path(path).map_err(|source| IoError::Read {
         path: path.to_path_buf(),
@@ -377,59 +383,16 @@ pub fn write_path(path: &Path, mesh: &IndexedMesh) -> Result<(), IoError> {
         .file_name()
         .and_then(|n| n.to_str())
         .is_some_and(|n| strip_gz(n).is_some());
-    let file_err = |action, source| IoError::File {
-        path: path.to_path_buf(),
-        action,
-        source,
-    };
-    let (tmp, file) = create_temp_beside(path).map_err(|e| file_err("create a file beside", e))?;
-    let result = (|| -> std::io::Result<()> {
-        let file = if gz {
+    write_atomically(path, |file| {
+        if gz {
             let mut enc = flate2::write::GzEncoder::new(file, flate2::Compression::default());
             write_to(&mut enc, mesh, format)?;
-            enc.finish()?
+            enc.finish()?;
+            Ok(())
         } else {
-            let mut file = file;
-            write_to(&mut file, mesh, format)?;
-            file
-        };
-        file.sync_all()
-    })();
-    let result = result
-        .map_err(|e| file_err("write", e))
-        .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| file_err("rename into", e)));
-    if result.is_err() {
-        // Best effort: the error being reported is the one that matters.
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
-}
-
-/// Creates a fresh file next to `path` named `.NAME.qem-tmp-PID-N`.
-fn create_temp_beside(path: &Path) -> std::io::Result<(PathBuf, std::fs::File)> {
-    use std::sync::atomic::{AtomicU64, Ordering};
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    loop {
-        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-        let tmp = dir.join(format!(".{name}.qem-tmp-{}-{n}", std::process::id()));
-        match std::fs::OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(&tmp)
-        {
-            Ok(f) => return Ok((tmp, f)),
-            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
-            Err(e) => return Err(e),
+            write_to(file, mesh, format)
         }
-    }
+    })
 }
 
 /// What `bytes` look like, for error messages when they are not the claimed format.
