@@ -65,6 +65,7 @@ fn run_single(args: &SimplifyArgs) -> Result<(), Failure> {
         )));
     }
     check_output_name(&args.output)?;
+    remove_stale_beside(&args.output);
     let bar = simplify_bar(bars_wanted(args.quiet), &file_name(&args.input));
     let result = simplify_file(
         &args.input,
@@ -162,6 +163,10 @@ fn run_levels(args: &SimplifyArgs) -> Result<(), Failure> {
     for o in &outputs {
         check_output_name(o)?;
     }
+    // `{lod}` may be in a directory name: each level's directory is cleaned.
+    for o in &outputs {
+        remove_stale_beside(o);
+    }
 
     let bar = simplify_bar(bars_wanted(args.quiet), &file_name(&args.input));
     let result = (|| {
@@ -231,6 +236,17 @@ fn check_output_name(output: &Path) -> Result<(), Failure> {
         ))),
         _ => Ok(()),
     }
+}
+
+/// Removes the temporary files killed runs left beside `output` (see
+/// [`qem_mesh::io::remove_stale_temporaries`]). Best effort: a directory that cannot be
+/// listed will fail the write with a clearer message.
+fn remove_stale_beside(output: &Path) {
+    let dir = match output.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let _ = qem_mesh::io::remove_stale_temporaries(dir);
 }
 
 fn lossy(p: &Path) -> String {

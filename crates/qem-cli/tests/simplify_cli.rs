@@ -203,3 +203,22 @@ fn latin1_cad_obj_is_simplified_and_its_notes_reported() {
         })
     );
 }
+
+/// A temporary file a killed run left beside the output is removed by the next run
+/// writing there; one of a live process (this test) is kept.
+#[cfg(target_os = "linux")]
+#[test]
+fn simplify_removes_stale_temporaries_beside_its_output() {
+    let dir = tempfile::tempdir().unwrap();
+    // No process 99999999 exists: Linux PIDs stay below 2^22.
+    let stale = dir.path().join(".out.obj.qem-tmp-99999999-0");
+    let live = dir
+        .path()
+        .join(format!(".out.obj.qem-tmp-{}-0", std::process::id()));
+    std::fs::write(&stale, b"half a mesh").unwrap();
+    std::fs::write(&live, b"being written").unwrap();
+    let out = dir.path().join("out.obj");
+    let o = qem(&["simplify", common::s(&spot()), "-o", common::s(&out), "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!stale.exists() && live.exists() && out.exists());
+}

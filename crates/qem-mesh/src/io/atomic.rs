@@ -23,10 +23,10 @@ pub const TEMP_MARKER: &str = ".qem-tmp-";
 pub const STALE_AGE_WITHOUT_PROC: Duration = Duration::from_secs(24 * 3600);
 
 /// Writes `path` atomically: `write` fills a new temporary file in the same directory
-/// (named as in the [module docs](self)), which is flushed to disk and renamed over
-/// `path`. On any error the temporary file is removed, so `path` either keeps its old
-/// content or gets the complete new one; the error names `path` and, for the usual
-/// causes (missing or read-only directory, full disk), says which it is.
+/// (named `.NAME.qem-tmp-PID-N`, see [`TEMP_MARKER`]), which is flushed to disk and
+/// renamed over `path`. On any error the temporary file is removed, so `path` either
+/// keeps its old content or gets the complete new one; the error names `path` and, for
+/// the usual causes (missing or read-only directory, full disk), says which it is.
 ///
 /// ```
 /// # fn main() -> Result<(), Box<dyn std::error::Error>> {

@@ -18,6 +18,13 @@
 //! Nothing else is checked or repaired: degenerate, duplicate and non-manifold faces
 //! pass through to the cleaning stage.
 //!
+//! **Lenient where the geometry is not at stake.** Names, comments, unknown keywords
+//! and properties may hold any bytes (Latin-1 names from CAD exports are common); a
+//! UTF-8 byte order mark, `\r\n` line ends and tabs are accepted. What was passed over
+//! is counted in [`LoadedMesh::notes`] ([`ReadNotes`]); OBJ names are kept byte for
+//! byte ([`ObjAttributes`]). Numbers, counts and indices stay strict: a malformed one
+//! is an error naming its line.
+//!
 //! **Bounded memory.** Counts above `MAX_ELEMENTS` are refused; no buffer is reserved
 //! beyond what the remaining bytes could hold; gzip output is capped at
 //! [`GZIP_MAX_RATIO`] times the compressed size and at [`GZIP_MAX_BYTES`].
@@ -25,9 +32,13 @@
 //! # Writing
 //! [`write_to`] writes any format to a `Write`; [`write_path`] writes a file
 //! atomically (a temporary file in the same directory, then a rename), gzipped when the
-//! name ends in `.gz`. OBJ and OFF are text with coordinates written in Rust's shortest
-//! round-trip form, PLY is `binary_little_endian` with `double` coordinates: all three
-//! read back bit-exact. STL is binary with `float32` coordinates (the format has no
+//! name ends in `.gz`. [`write_atomically`] is that atomic step for any content, and
+//! [`remove_stale_temporaries`] removes the temporary files of writers that were
+//! killed before their rename.
+//!
+//! OBJ and OFF are text with coordinates written in Rust's shortest round-trip form,
+//! PLY is `binary_little_endian` with `double` coordinates: all three read back
+//! bit-exact. STL is binary with `float32` coordinates (the format has no
 //! other choice) and facet normals computed from the triangles; a coordinate beyond
 //! float32's range (about ±3.4e38) is an `InvalidInput` error rather than an infinity
 //! in the file.
