@@ -102,3 +102,33 @@ fn every_corpus_directory_has_a_target() {
         assert!(source.is_file(), "{} is missing", source.display());
     }
 }
+
+/// The reader seeds with bytes that are not UTF-8 in names and comments (issue 33) must
+/// load, not merely fail cleanly: the replay above accepts a one-line error, which is
+/// what the readers gave for them before they were lenient.
+#[test]
+fn seeds_with_non_utf8_names_load() {
+    use qem_mesh::io::{read_bytes, Format};
+    let seeds = [
+        ("read_obj", "latin1_names_bom_crlf", Format::Obj),
+        ("read_obj", "non_utf8_unknown_and_nbsp_lines", Format::Obj),
+        ("read_ply", "latin1_header_bom_crlf", Format::Ply),
+        ("read_off", "latin1_comments_bom_crlf", Format::Off),
+        ("read_stl", "latin1_solid_name_bom", Format::Stl),
+    ];
+    for (target, name, format) in seeds {
+        let path = fuzz_dir().join("corpus").join(target).join(name);
+        let data = std::fs::read(&path).expect("the seed exists");
+        assert!(
+            std::str::from_utf8(&data).is_err(),
+            "{name} should hold bytes that are not UTF-8"
+        );
+        let loaded = read_bytes(&data, format)
+            .unwrap_or_else(|e| panic!("{}: refused: {e}", path.display()));
+        assert!(
+            loaded.notes.non_utf8_lines > 0,
+            "{name}: {:?}",
+            loaded.notes
+        );
+    }
+}

@@ -3,9 +3,16 @@
 //! Every file is simplified on its own (the library call is deterministic), so the
 //! outputs do not depend on `-j`; the report lists the inputs sorted by path. One bad
 //! file never stops the others: it is reported with its cause and the run goes on.
+//!
+//! Each completed file is recorded in a manifest beside the outputs ([`crate::manifest`])
+//! as soon as its output is in place, so `--resume` after a crash, a kill or a full
+//! disk skips what is done and runs the rest; the report covers every input either
+//! way. Temporary files that killed runs left in the output directories are removed
+//! first ([`qem_mesh::io::remove_stale_temporaries`]).
 
 use crate::failure::Failure;
 use crate::inputs::{expand, output_path, Input};
+use crate::manifest::{fingerprint, InputStamp, Manifest, Record};
 use crate::options::SimplifyFlags;
 use crate::progress::{bars_wanted, batch_bar, interrupted, CtrlCObserver};
 use crate::report::{write_json_atomically, BatchEntry, BatchJson, BatchSummary, SimplifyJson};
@@ -13,7 +20,7 @@ use crate::simplify_cmd::simplify_file;
 use clap::{Args, ValueEnum};
 use qem_mesh::io::Format;
 use qem_mesh::simplify::SimplifyOptions;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
@@ -70,9 +77,25 @@ pub struct BatchArgs {
     /// report].
     #[arg(long, value_name = "REPORT.json")]
     pub report: Option<PathBuf>,
+    /// Skip inputs that an earlier run with the same options completed: their output
+    /// exists and matches the manifest in the output directory (size and CRC-32), and
+    /// the input's size and modification time are unchanged. The rest run; the report
+    /// covers every input [default: off, every input runs].
+    #[arg(long)]
+    pub resume: bool,
     /// No progress bar and no summary line; failures are still printed [default: off].
     #[arg(short, long)]
     pub quiet: bool,
+}
+
+/// How one task ended.
+enum Outcome {
+    /// Simplified and written by this run.
+    Done(Box<SimplifyJson>),
+    /// Completed by an earlier run (`--resume`): its report.
+    Resumed(serde_json::Value),
+    /// Failed: the one-line message.
+    Failed(String),
 }
 
 /// One input with where its output goes, or why it cannot be run.
@@ -118,6 +141,17 @@ pub fn run(args: &BatchArgs) -> Result<(), Failure> {
         .map_err(|e| Failure::Failed(format!("cannot start {jobs} worker threads: {e}")))?;
 
     let options = args.flags.options()?;
+    let format = args.format.map(Format::from);
+    let fingerprint = fingerprint(&options, &format);
+    let stale = remove_stale(&args.out_dir, &tasks);
+    // No manifest when nothing can run (every input refused): the output directory is
+    // then left as it was.
+    let manifest = match tasks.iter().any(|t| t.refused.is_none()) {
+        true => Some(Manifest::open(&args.out_dir, args.resume).map_err(Failure::Failed)?),
+        false => None,
+    };
+    // One warning for the whole run: every later append would fail the same way.
+    let manifest_warning: std::sync::Mutex<Option<String>> = std::sync::Mutex::new(None);
     let bar = batch_bar(bars_wanted(args.quiet), tasks.len());
     let failed_so_far = AtomicUsize::new(0);
     let clock = Instant::now();
@@ -130,23 +164,28 @@ pub fn run(args: &BatchArgs) -> Result<(), Failure> {
     let sizes: Vec<u64> = tasks.iter().map(Task::file_size).collect();
     order.sort_by(|&a, &b| sizes[b].cmp(&sizes[a]).then(a.cmp(&b)));
     let next = AtomicUsize::new(0);
-    let per_worker: Vec<Vec<(usize, Result<SimplifyJson, String>)>> = pool.broadcast(|_| {
+    let per_worker: Vec<Vec<(usize, Outcome)>> = pool.broadcast(|_| {
         let mut done = Vec::new();
         while let Some(&i) = order.get(next.fetch_add(1, Ordering::Relaxed)) {
-            let result = run_task(&tasks[i], &options);
-            if result.is_err() {
+            let task = &tasks[i];
+            let (outcome, warning) =
+                run_recorded(task, &options, &fingerprint, args.resume, manifest.as_ref());
+            if let Some(warning) = warning {
+                let mut slot = manifest_warning.lock().unwrap_or_else(|p| p.into_inner());
+                slot.get_or_insert(warning);
+            }
+            if let Outcome::Failed(_) = outcome {
                 let n = failed_so_far.fetch_add(1, Ordering::Relaxed) + 1;
                 bar.set_message(format!("{n} failed"));
             }
             bar.inc(1);
-            done.push((i, result));
+            done.push((i, outcome));
         }
         done
     });
-    let mut results: Vec<Option<Result<SimplifyJson, String>>> =
-        (0..tasks.len()).map(|_| None).collect();
-    for (i, result) in per_worker.into_iter().flatten() {
-        results[i] = Some(result);
+    let mut results: Vec<Option<Outcome>> = (0..tasks.len()).map(|_| None).collect();
+    for (i, outcome) in per_worker.into_iter().flatten() {
+        results[i] = Some(outcome);
     }
     let wall = clock.elapsed();
     bar.finish_and_clear();
@@ -154,16 +193,28 @@ pub fn run(args: &BatchArgs) -> Result<(), Failure> {
     let stopped = interrupted();
     let mut entries = Vec::with_capacity(tasks.len());
     let mut failures = Vec::new();
-    let (mut triangles_in, mut triangles_out) = (0, 0);
+    let (mut triangles_in, mut triangles_out, mut resumed, mut simplified_in) = (0, 0, 0, 0);
     for (task, result) in tasks.iter().zip(results) {
-        let result = result.unwrap_or_else(|| Err(format!("{}: was not run (a bug)", task.input)));
+        let result = result
+            .unwrap_or_else(|| Outcome::Failed(format!("{}: was not run (a bug)", task.input)));
         match result {
-            Ok(json) => {
+            Outcome::Done(json) => {
                 triangles_in += json.triangles_in();
+                simplified_in += json.triangles_in();
                 triangles_out += json.triangles_out();
                 entries.push(BatchEntry::Done(json));
             }
-            Err(error) => {
+            Outcome::Resumed(mut json) => {
+                let count = |key: &str| json[key].as_u64().unwrap_or(0) as usize;
+                triangles_in += count("triangles_in");
+                triangles_out += count("triangles_out");
+                resumed += 1;
+                if let Some(map) = json.as_object_mut() {
+                    map.insert("resumed".into(), serde_json::Value::Bool(true));
+                }
+                entries.push(BatchEntry::Resumed(json));
+            }
+            Outcome::Failed(error) => {
                 failures.push(error.clone());
                 entries.push(BatchEntry::Failed {
                     input: task.input.clone(),
@@ -178,14 +229,16 @@ pub fn run(args: &BatchArgs) -> Result<(), Failure> {
     let summary = BatchSummary {
         inputs: tasks.len(),
         succeeded,
+        resumed,
         failed: failures.len(),
         interrupted: stopped,
         jobs,
+        stale_temporaries_removed: stale,
         triangles_in,
         triangles_out,
         wall_ms: seconds * 1e3,
         input_triangles_per_second: if seconds > 0.0 {
-            triangles_in as f64 / seconds
+            simplified_in as f64 / seconds
         } else {
             0.0
         },
@@ -193,10 +246,28 @@ pub fn run(args: &BatchArgs) -> Result<(), Failure> {
     for line in &failures {
         eprintln!("qem: error: {line}");
     }
+    let manifest_warning = manifest_warning
+        .into_inner()
+        .unwrap_or_else(|p| p.into_inner());
+    if let Some(warning) = &manifest_warning {
+        eprintln!("qem: warning: {warning}");
+    }
     if !args.quiet {
+        if stale > 0 {
+            eprintln!(
+                "qem: removed {stale} temporary {} left by killed runs",
+                if stale == 1 { "file" } else { "files" }
+            );
+        }
+        let earlier = if resumed > 0 {
+            format!(" ({resumed} of them by an earlier run)")
+        } else {
+            String::new()
+        };
         eprintln!(
-            "qem: {succeeded} of {} files simplified into {}, {} failed; {triangles_in} → \
-             {triangles_out} triangles in {seconds:.2} s ({:.0} input triangles/s, {jobs} jobs)",
+            "qem: {succeeded} of {} files simplified into {}{earlier}, {} failed; \
+             {triangles_in} → {triangles_out} triangles in {seconds:.2} s ({:.0} input \
+             triangles/s, {jobs} jobs)",
             tasks.len(),
             args.out_dir.display(),
             failures.len(),
@@ -301,6 +372,51 @@ fn plan(
     }));
     tasks.sort_by(|a, b| a.input.cmp(&b.input));
     tasks
+}
+
+/// Removes the temporary files of killed runs from the output directory and every
+/// existing directory an output goes to; returns how many. A directory that cannot be
+/// listed is left alone: writing there will say what is wrong.
+fn remove_stale(out_dir: &Path, tasks: &[Task]) -> usize {
+    let mut dirs: BTreeSet<&Path> = BTreeSet::from([out_dir]);
+    dirs.extend(tasks.iter().filter_map(|t| t.output.as_deref()?.parent()));
+    dirs.iter()
+        .filter_map(|d| qem_mesh::io::remove_stale_temporaries(d).ok())
+        .map(|removed| removed.len())
+        .sum()
+}
+
+/// Runs one task unless `--resume` finds it complete, and records a success in the
+/// manifest; with the outcome, the warning when recording it failed.
+fn run_recorded(
+    task: &Task,
+    options: &SimplifyOptions,
+    fingerprint: &str,
+    resume: bool,
+    manifest: Option<&Manifest>,
+) -> (Outcome, Option<String>) {
+    // The stamp is taken before the input is read: an input changed while it is being
+    // simplified then no longer matches its record, and a later resume runs it again.
+    let stamp = task.path.as_deref().and_then(InputStamp::of);
+    if let (true, Some(output), Some(m)) =
+        (resume && task.refused.is_none(), &task.output, manifest)
+    {
+        if let Some(record) = m.completed(&task.input, stamp, output, fingerprint) {
+            return (Outcome::Resumed(record.report.clone()), None);
+        }
+    }
+    let json = match run_task(task, options) {
+        Ok(json) => json,
+        Err(e) => return (Outcome::Failed(e), None),
+    };
+    let (Some(stamp), Some(output), Some(manifest)) = (stamp, &task.output, manifest) else {
+        return (Outcome::Done(Box::new(json)), None);
+    };
+    let report = serde_json::to_value(&json).unwrap_or_default();
+    let recorded = Record::new(task.input.clone(), stamp, output, fingerprint, report)
+        .ok_or_else(|| format!("{}: cannot read back to record it", output.display()))
+        .and_then(|record| manifest.append(&record));
+    (Outcome::Done(Box::new(json)), recorded.err())
 }
 
 /// Simplifies one input; the error is the one-line message.

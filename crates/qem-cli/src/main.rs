@@ -9,6 +9,7 @@ mod batch_cmd;
 mod failure;
 mod info_cmd;
 mod inputs;
+mod manifest;
 mod measure_cmd;
 mod options;
 mod progress;

@@ -1,6 +1,7 @@
 //! JSON reports, written atomically. Field names are the documented JSON keys.
 
 use qem_mesh::inspect::MeshInfo;
+use qem_mesh::io::ReadNotes;
 use qem_mesh::simplify::SimplifyReport;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -40,7 +41,30 @@ pub struct SimplifyJson {
     /// Output faces whose normal points away from their input face (0 unless the
     /// fold-over check is off).
     faces_flipped: usize,
+    /// What the reader passed over (issue 33): `skipped_lines`, `skipped_properties`,
+    /// `non_utf8_lines`, `byte_order_mark`.
+    read_notes: ReadNotesJson,
     timings_ms: BTreeMap<&'static str, f64>,
+}
+
+/// [`ReadNotes`] as JSON.
+#[derive(Serialize, Debug, Clone, Copy, Default)]
+pub struct ReadNotesJson {
+    skipped_lines: usize,
+    skipped_properties: usize,
+    non_utf8_lines: usize,
+    byte_order_mark: bool,
+}
+
+impl From<ReadNotes> for ReadNotesJson {
+    fn from(n: ReadNotes) -> Self {
+        ReadNotesJson {
+            skipped_lines: n.skipped_lines,
+            skipped_properties: n.skipped_properties,
+            non_utf8_lines: n.non_utf8_lines,
+            byte_order_mark: n.byte_order_mark,
+        }
+    }
 }
 
 fn ms(d: Duration) -> f64 {
@@ -48,11 +72,13 @@ fn ms(d: Duration) -> f64 {
 }
 
 impl SimplifyJson {
-    /// Collects the report of a run with its file names and the CLI's own timings.
+    /// Collects the report of a run with its file names, what the reader passed over
+    /// and the CLI's own timings.
     pub fn new(
         input: &Path,
         output: &Path,
         r: &SimplifyReport,
+        notes: ReadNotes,
         load: Duration,
         simplify: Duration,
         write: Duration,
@@ -107,6 +133,7 @@ impl SimplifyJson {
             ]),
             locked_vertices: r.locked_vertices,
             faces_flipped: r.faces_flipped,
+            read_notes: notes.into(),
             timings_ms,
         }
     }
@@ -164,7 +191,10 @@ pub struct LevelsJson {
 #[serde(untagged)]
 pub enum BatchEntry {
     /// The file was simplified and written.
-    Done(SimplifyJson),
+    Done(Box<SimplifyJson>),
+    /// An earlier run simplified and wrote it (`--resume`): that run's report, with
+    /// `"resumed": true` added.
+    Resumed(serde_json::Value),
     /// The file failed; nothing was written for it.
     Failed {
         /// The input file.
@@ -181,21 +211,26 @@ pub enum BatchEntry {
 pub struct BatchSummary {
     /// Inputs found (files named, matched by globs, found in directories).
     pub inputs: usize,
-    /// Inputs simplified and written.
+    /// Inputs simplified and written, by this run or (with `--resume`) an earlier one.
     pub succeeded: usize,
+    /// Of `succeeded`, the inputs an earlier run completed (`--resume`).
+    pub resumed: usize,
     /// Inputs that failed (or were not started because of Ctrl-C).
     pub failed: usize,
     /// Whether Ctrl-C stopped the run.
     pub interrupted: bool,
     /// Worker threads.
     pub jobs: usize,
+    /// Temporary files of killed runs removed from the output directories.
+    pub stale_temporaries_removed: usize,
     /// Triangles of the succeeded inputs, as loaded.
     pub triangles_in: usize,
     /// Triangles written.
     pub triangles_out: usize,
     /// Wall time of the whole run, from the first load to the last write.
     pub wall_ms: f64,
-    /// `triangles_in` per second of `wall_ms`.
+    /// Input triangles simplified by this run (not the resumed ones) per second of
+    /// `wall_ms`.
     pub input_triangles_per_second: f64,
 }
 
@@ -255,17 +290,14 @@ impl InfoJson {
 }
 
 /// Writes `value` as pretty JSON to `path` through a temporary file in the same
-/// directory, so a failure never leaves a partial report.
+/// directory (qem's own, so a killed run's is cleaned up by the next), so a failure
+/// never leaves a partial report.
 pub fn write_json_atomically(path: &Path, value: &impl Serialize) -> Result<(), String> {
-    let fail =
-        |e: &dyn std::fmt::Display| format!("{}: cannot write the report: {e}", path.display());
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(|e| fail(&e))?;
-    serde_json::to_writer_pretty(&mut tmp, value).map_err(|e| fail(&e))?;
-    tmp.write_all(b"\n").map_err(|e| fail(&e))?;
-    tmp.persist(path).map_err(|e| fail(&e.error))?;
-    Ok(())
+    qem_mesh::io::write_atomically(path, |file| {
+        let mut out = std::io::BufWriter::new(file);
+        serde_json::to_writer_pretty(&mut out, value)?;
+        out.write_all(b"\n")?;
+        out.flush()
+    })
+    .map_err(|e| e.to_string())
 }

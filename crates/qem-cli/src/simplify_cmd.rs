@@ -6,7 +6,7 @@ use crate::options::{parse_ratio, SimplifyFlags};
 use crate::progress::{bars_wanted, interrupted, simplify_bar, BarObserver};
 use crate::report::{write_json_atomically, LevelJson, LevelsJson, SimplifyJson};
 use clap::Args;
-use qem_mesh::io::{read_path, write_path, Format};
+use qem_mesh::io::{read_path, write_path, Format, ReadNotes};
 use qem_mesh::simplify::{
     simplify_levels, simplify_observed, Observer, Simplified, SimplifyOptions, StopReason, Target,
 };
@@ -65,6 +65,7 @@ fn run_single(args: &SimplifyArgs) -> Result<(), Failure> {
         )));
     }
     check_output_name(&args.output)?;
+    remove_stale_beside(&args.output);
     let bar = simplify_bar(bars_wanted(args.quiet), &file_name(&args.input));
     let result = simplify_file(
         &args.input,
@@ -94,7 +95,7 @@ pub fn simplify_file(
     observer: &mut dyn Observer,
     create_dirs: bool,
 ) -> Result<SimplifyJson, Failure> {
-    let (mesh, load) = load(input)?;
+    let (mesh, notes, load) = load(input)?;
     let clock = Instant::now();
     let result = simplify_observed(&mesh, options, observer)
         .map_err(|e| Failure::Failed(format!("{}: {e}", input.display())))?;
@@ -118,19 +119,20 @@ pub fn simplify_file(
         input,
         output,
         &result.report,
+        notes,
         load,
         simplify_time,
         write,
     ))
 }
 
-fn load(input: &Path) -> Result<(qem_mesh::IndexedMesh, Duration), Failure> {
+fn load(input: &Path) -> Result<(qem_mesh::IndexedMesh, ReadNotes, Duration), Failure> {
     let clock = Instant::now();
     let loaded = read_path(input).map_err(|e| Failure::Failed(e.to_string()))?;
     if interrupted() {
         return Err(Failure::Interrupted);
     }
-    Ok((loaded.mesh, clock.elapsed()))
+    Ok((loaded.mesh, loaded.notes, clock.elapsed()))
 }
 
 fn write(output: &Path, result: &Simplified) -> Result<Duration, Failure> {
@@ -161,10 +163,14 @@ fn run_levels(args: &SimplifyArgs) -> Result<(), Failure> {
     for o in &outputs {
         check_output_name(o)?;
     }
+    // `{lod}` may be in a directory name: each level's directory is cleaned.
+    for o in &outputs {
+        remove_stale_beside(o);
+    }
 
     let bar = simplify_bar(bars_wanted(args.quiet), &file_name(&args.input));
     let result = (|| {
-        let (mesh, load) = load(&args.input)?;
+        let (mesh, notes, load) = load(&args.input)?;
         let targets: Vec<Target> = args.lods.iter().map(|&r| Target::Ratio(r)).collect();
         let clock = Instant::now();
         let levels = simplify_levels(
@@ -174,10 +180,10 @@ fn run_levels(args: &SimplifyArgs) -> Result<(), Failure> {
             &mut BarObserver::new(&bar),
         )
         .map_err(|e| Failure::Failed(format!("{}: {e}", args.input.display())))?;
-        Ok((levels, load, clock.elapsed()))
+        Ok((levels, notes, load, clock.elapsed()))
     })();
     bar.finish_and_clear();
-    let (levels, load, simplify_time) = result?;
+    let (levels, notes, load, simplify_time) = result?;
     if interrupted()
         || levels
             .iter()
@@ -197,6 +203,7 @@ fn run_levels(args: &SimplifyArgs) -> Result<(), Failure> {
             &args.input,
             output,
             &level.report,
+            notes,
             load,
             simplify_time,
             write,
@@ -229,6 +236,17 @@ fn check_output_name(output: &Path) -> Result<(), Failure> {
         ))),
         _ => Ok(()),
     }
+}
+
+/// Removes the temporary files killed runs left beside `output` (see
+/// [`qem_mesh::io::remove_stale_temporaries`]). Best effort: a directory that cannot be
+/// listed will fail the write with a clearer message.
+fn remove_stale_beside(output: &Path) {
+    let dir = match output.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let _ = qem_mesh::io::remove_stale_temporaries(dir);
 }
 
 fn lossy(p: &Path) -> String {

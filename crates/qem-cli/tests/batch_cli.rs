@@ -7,6 +7,9 @@ use common::{bumpy_grid, json, qem, s, spot, stderr};
 use qem_mesh::io::{read_path, write_path};
 use std::path::{Path, PathBuf};
 
+/// The manifest `qem batch` keeps in the output directory.
+const MANIFEST: &str = ".qem-batch-manifest.jsonl";
+
 const CORRUPT_PLY: &[u8] =
     b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n1\n";
 
@@ -23,10 +26,13 @@ fn messy_folder(root: &Path) {
     std::fs::write(root.join("spot.mtl"), b"newmtl skin\n").expect("set up the test files");
 }
 
+/// The files under `dir`, relative to it, without the batch manifest (which
+/// `resume_skips_what_is_done` and the soak test check on their own).
 fn files_under(dir: &Path) -> Vec<PathBuf> {
     let mut out: Vec<PathBuf> = walk(dir)
         .into_iter()
         .map(|p| p.strip_prefix(dir).expect("walk the output").to_path_buf())
+        .filter(|p| p != Path::new(MANIFEST))
         .collect();
     out.sort();
     out
@@ -472,4 +478,205 @@ fn inputs_are_never_overwritten() {
     assert!(stderr(&o).contains("would overwrite it"), "{}", stderr(&o));
     assert!(std::fs::read(&a).unwrap() == before);
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+}
+
+/// The report's entries without what differs between runs (timings, `resumed`).
+fn entries_without_timings(report: &Path) -> Vec<serde_json::Value> {
+    let mut entries = json(report)["inputs"]
+        .as_array()
+        .expect("the report lists inputs")
+        .clone();
+    for e in &mut entries {
+        let e = e.as_object_mut().expect("an entry is an object");
+        e.remove("timings_ms");
+        e.remove("resumed");
+    }
+    entries
+}
+
+fn modified(p: &Path) -> std::time::SystemTime {
+    std::fs::metadata(p)
+        .and_then(|m| m.modified())
+        .expect("a modification time")
+}
+
+#[test]
+fn resume_skips_what_is_done_and_reports_every_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    messy_folder(&input);
+    let out = dir.path().join("out");
+    let report = |n: u32| dir.path().join(format!("r{n}.json"));
+    let run = |n: u32, extra: &[&str]| {
+        let r = report(n);
+        let mut args = vec!["batch", s(&input), "--out-dir", s(&out), "--report", s(&r)];
+        args.extend_from_slice(extra);
+        let o = qem(&args);
+        // corrupt.ply fails in every run.
+        assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+        (json(&r)["summary"].clone(), stderr(&o))
+    };
+    let (first, _) = run(1, &[]);
+    assert_eq!(
+        (first["succeeded"].as_u64(), first["resumed"].as_u64()),
+        (Some(4), Some(0))
+    );
+    assert!(out.join(MANIFEST).is_file());
+    let outputs = files_under(&out);
+    let times: Vec<_> = outputs.iter().map(|f| modified(&out.join(f))).collect();
+
+    // Temporary files of killed runs (no process 99999999 exists: Linux PIDs stay
+    // below 2^22) are removed; one of a live process (this test) is kept.
+    let own = format!(".grid.ply.qem-tmp-{}-0", std::process::id());
+    for stale in [
+        ".spot.obj.qem-tmp-99999999-0",
+        "sub/.grid.stl.qem-tmp-99999999-1",
+        &own,
+    ] {
+        std::fs::write(out.join(stale), b"half a mesh").unwrap();
+    }
+    let (second, err) = run(2, &["--resume"]);
+    assert_eq!(second["resumed"].as_u64(), Some(4), "{err}");
+    assert_eq!(second["succeeded"].as_u64(), Some(4));
+    assert_eq!(second["failed"].as_u64(), Some(1));
+    assert_eq!(second["triangles_in"], first["triangles_in"]);
+    assert_eq!(second["triangles_out"], first["triangles_out"]);
+    assert_eq!(second["stale_temporaries_removed"].as_u64(), Some(2));
+    assert!(err.contains("(4 of them by an earlier run)"), "{err}");
+    assert!(
+        err.contains("removed 2 temporary files left by killed runs"),
+        "{err}"
+    );
+    assert!(!out.join(".spot.obj.qem-tmp-99999999-0").exists());
+    assert!(out.join(&own).exists());
+    std::fs::remove_file(out.join(&own)).unwrap();
+    // Nothing was rewritten, and the report covers every input as the first one did.
+    assert_eq!(files_under(&out), outputs);
+    let again: Vec<_> = outputs.iter().map(|f| modified(&out.join(f))).collect();
+    assert_eq!(again, times);
+    assert_eq!(
+        entries_without_timings(&report(2)),
+        entries_without_timings(&report(1))
+    );
+    let resumed = json(&report(2))["inputs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|e| e["resumed"] == true)
+        .count();
+    assert_eq!(resumed, 4);
+
+    // A changed input and a missing output run again; the rest is still done.
+    write_path(&input.join("grid.ply"), &bumpy_grid(12, 7)).unwrap();
+    std::fs::remove_file(out.join("spot.obj")).unwrap();
+    let (third, _) = run(3, &["--resume"]);
+    assert_eq!(third["resumed"].as_u64(), Some(2));
+    assert_eq!(third["succeeded"].as_u64(), Some(4));
+    assert!(out.join("spot.obj").is_file());
+    // An output changed behind qem's back runs again too.
+    std::fs::write(out.join("sub/grid.stl"), b"not what qem wrote").unwrap();
+    let (fourth, _) = run(4, &["--resume"]);
+    assert_eq!(fourth["resumed"].as_u64(), Some(3));
+    assert!(read_path(&out.join("sub/grid.stl")).is_ok());
+    // Other options: nothing counts as done.
+    let (fifth, _) = run(5, &["--resume", "--ratio", "0.3"]);
+    assert_eq!(fifth["resumed"].as_u64(), Some(0));
+    // Without --resume everything runs.
+    let (sixth, _) = run(6, &[]);
+    assert_eq!(sixth["resumed"].as_u64(), Some(0));
+    assert_eq!(sixth["succeeded"].as_u64(), Some(4));
+}
+
+/// Runs `qem` so that directory permissions apply to it. Root ignores them, so when
+/// this test runs as root (a container) the child runs as `nobody` instead.
+#[cfg(unix)]
+fn qem_where_permissions_apply(args: &[&str]) -> std::process::Output {
+    use std::os::unix::fs::PermissionsExt;
+    use std::os::unix::process::CommandExt;
+    let scratch = tempfile::tempdir().expect("a scratch directory");
+    let probe = scratch.path().join("probe");
+    std::fs::create_dir(&probe).expect("a probe directory");
+    std::fs::set_permissions(&probe, std::fs::Permissions::from_mode(0o555))
+        .expect("a read-only probe directory");
+    let privileged = std::fs::write(probe.join("x"), b"").is_ok();
+    let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_qem"));
+    cmd.args(args);
+    if privileged {
+        cmd.uid(65534).gid(65534);
+    }
+    cmd.output().expect("qem runs")
+}
+
+/// A read-only output directory is found before any work (one line, nothing written);
+/// a read-only or blocked subdirectory fails its own inputs, one line each, and the
+/// batch goes on with the rest.
+#[cfg(unix)]
+#[test]
+fn unwritable_output_directories_fail_with_one_line_each() {
+    use std::os::unix::fs::PermissionsExt;
+    let mode = |p: &Path, m: u32| {
+        std::fs::set_permissions(p, std::fs::Permissions::from_mode(m)).unwrap();
+    };
+    let dir = tempfile::tempdir().unwrap();
+    mode(dir.path(), 0o777);
+    let input = dir.path().join("in");
+    std::fs::create_dir_all(input.join("locked")).unwrap();
+    std::fs::create_dir_all(input.join("blocked")).unwrap();
+    write_path(&input.join("a.ply"), &bumpy_grid(6, 0)).unwrap();
+    write_path(&input.join("locked/b.ply"), &bumpy_grid(6, 1)).unwrap();
+    write_path(&input.join("blocked/c.ply"), &bumpy_grid(6, 2)).unwrap();
+    for d in [&input, &input.join("locked"), &input.join("blocked")] {
+        mode(d, 0o755);
+    }
+
+    // The whole output directory is read-only.
+    let out = dir.path().join("read-only");
+    std::fs::create_dir(&out).unwrap();
+    mode(&out, 0o555);
+    let o = qem_where_permissions_apply(&["batch", s(&input), "--out-dir", s(&out)]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert_eq!(
+        stderr(&o),
+        format!(
+            "qem: error: {}: cannot write (its directory is not writable): Permission denied \
+             (os error 13); nothing was simplified\n",
+            out.join(MANIFEST).display()
+        )
+    );
+    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 0);
+
+    // A read-only subdirectory, and a file where a subdirectory should be (the output
+    // path's directory cannot exist).
+    let out = dir.path().join("out");
+    std::fs::create_dir_all(out.join("locked")).unwrap();
+    mode(&out, 0o777);
+    mode(&out.join("locked"), 0o555);
+    std::fs::write(out.join("blocked"), b"a file, not a directory").unwrap();
+    let o = qem_where_permissions_apply(&["batch", s(&input), "--out-dir", s(&out), "-j", "1"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let err = stderr(&o);
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(lines.len(), 3, "{err}");
+    assert!(
+        lines[0].starts_with(&format!(
+            "qem: error: {}: cannot create the directory {}: ",
+            out.join("blocked/c.ply").display(),
+            out.join("blocked").display()
+        )),
+        "{err}"
+    );
+    assert_eq!(
+        lines[1],
+        format!(
+            "qem: error: {}: cannot write (its directory is not writable): Permission denied \
+             (os error 13)",
+            out.join("locked/b.ply").display()
+        )
+    );
+    assert!(lines[2].contains("1 of 3 files simplified"), "{err}");
+    assert_eq!(
+        files_under(&out),
+        vec![PathBuf::from("a.ply"), PathBuf::from("blocked")]
+    );
+    assert_eq!(std::fs::read_dir(out.join("locked")).unwrap().count(), 0);
 }

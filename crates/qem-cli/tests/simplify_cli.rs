@@ -169,3 +169,56 @@ fn ctrl_c_leaves_no_output() {
         "only the input is left"
     );
 }
+
+/// Issue 33's OBJ from European CAD software (the fixture: Latin-1 `usemtl` and `g`
+/// names, a byte order mark, CRLF) is simplified, and the report says what the reader
+/// passed over.
+#[test]
+fn latin1_cad_obj_is_simplified_and_its_notes_reported() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../qem-mesh/tests/fixtures/latin1_bom_crlf.obj");
+    let out = dir.path().join("out.obj");
+    let report = dir.path().join("report.json");
+    let o = qem(&[
+        "simplify",
+        common::s(&input),
+        "-o",
+        common::s(&out),
+        "--triangles",
+        "4",
+        "--report",
+        common::s(&report),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let r = common::json(&report);
+    assert_eq!(r["triangles_in"], 6);
+    assert_eq!(
+        r["read_notes"],
+        serde_json::json!({
+            "skipped_lines": 2,
+            "skipped_properties": 0,
+            "non_utf8_lines": 5,
+            "byte_order_mark": true
+        })
+    );
+}
+
+/// A temporary file a killed run left beside the output is removed by the next run
+/// writing there; one of a live process (this test) is kept.
+#[cfg(target_os = "linux")]
+#[test]
+fn simplify_removes_stale_temporaries_beside_its_output() {
+    let dir = tempfile::tempdir().unwrap();
+    // No process 99999999 exists: Linux PIDs stay below 2^22.
+    let stale = dir.path().join(".out.obj.qem-tmp-99999999-0");
+    let live = dir
+        .path()
+        .join(format!(".out.obj.qem-tmp-{}-0", std::process::id()));
+    std::fs::write(&stale, b"half a mesh").unwrap();
+    std::fs::write(&live, b"being written").unwrap();
+    let out = dir.path().join("out.obj");
+    let o = qem(&["simplify", common::s(&spot()), "-o", common::s(&out), "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!stale.exists() && live.exists() && out.exists());
+}

@@ -400,7 +400,10 @@ fn failed_write_leaves_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let missing = dir.path().join("no/such/dir/m.obj");
     let e = write_path(&missing, &quad()).unwrap_err();
-    assert_contains(&e.to_string(), "m.obj: cannot create a file beside");
+    assert_contains(
+        &e.to_string(),
+        "m.obj: cannot write (its directory does not exist)",
+    );
     let mut bad = quad();
     bad.triangles.push([0, 1, 99]);
     let path = dir.path().join("bad.ply");

@@ -18,6 +18,13 @@
 //! Nothing else is checked or repaired: degenerate, duplicate and non-manifold faces
 //! pass through to the cleaning stage.
 //!
+//! **Lenient where the geometry is not at stake.** Names, comments, unknown keywords
+//! and properties may hold any bytes (Latin-1 names from CAD exports are common); a
+//! UTF-8 byte order mark, `\r\n` line ends and tabs are accepted. What was passed over
+//! is counted in [`LoadedMesh::notes`] ([`ReadNotes`]); OBJ names are kept byte for
+//! byte ([`ObjAttributes`]). Numbers, counts and indices stay strict: a malformed one
+//! is an error naming its line.
+//!
 //! **Bounded memory.** Counts above `MAX_ELEMENTS` are refused; no buffer is reserved
 //! beyond what the remaining bytes could hold; gzip output is capped at
 //! [`GZIP_MAX_RATIO`] times the compressed size and at [`GZIP_MAX_BYTES`].
@@ -25,9 +32,13 @@
 //! # Writing
 //! [`write_to`] writes any format to a `Write`; [`write_path`] writes a file
 //! atomically (a temporary file in the same directory, then a rename), gzipped when the
-//! name ends in `.gz`. OBJ and OFF are text with coordinates written in Rust's shortest
-//! round-trip form, PLY is `binary_little_endian` with `double` coordinates: all three
-//! read back bit-exact. STL is binary with `float32` coordinates (the format has no
+//! name ends in `.gz`. [`write_atomically`] is that atomic step for any content, and
+//! [`remove_stale_temporaries`] removes the temporary files of writers that were
+//! killed before their rename.
+//!
+//! OBJ and OFF are text with coordinates written in Rust's shortest round-trip form,
+//! PLY is `binary_little_endian` with `double` coordinates: all three read back
+//! bit-exact. STL is binary with `float32` coordinates (the format has no
 //! other choice) and facet normals computed from the triangles; a coordinate beyond
 //! float32's range (about ±3.4e38) is an `InvalidInput` error rather than an infinity
 //! in the file.
@@ -46,6 +57,7 @@
 //! assert_eq!(loaded.mesh, mesh);
 //! ```
 
+mod atomic;
 mod error;
 pub mod obj;
 mod off;
@@ -54,8 +66,12 @@ mod stl;
 mod text;
 
 use std::io::{Read, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
+pub use atomic::{
+    remove_stale_temporaries, temporary_owner, write_atomically, STALE_AGE_WITHOUT_PROC,
+    TEMP_MARKER,
+};
 pub use error::{IoError, Location, ReadError, ReadErrorKind};
 pub use obj::ObjAttributes;
 
@@ -162,8 +178,56 @@ fn strip_gz(name: &str) -> Option<&str> {
 pub struct LoadedMesh {
     /// The triangles and positions; passes [`IndexedMesh::validate`].
     pub mesh: IndexedMesh,
-    /// Texture coordinates and normals of an OBJ file (`None` for other formats).
+    /// Texture coordinates, normals and names of an OBJ file (`None` for other formats).
     pub obj: Option<ObjAttributes>,
+    /// What the reader passed over without using it.
+    pub notes: ReadNotes,
+}
+
+/// What a reader passed over: parts of the file that carry nothing qem uses.
+///
+/// The readers are lenient where a format gives bytes no meaning for the geometry
+/// (names, comments, unknown keywords and properties) and strict where it does (a
+/// malformed number is an error naming its line). These counts say how much was passed
+/// over, so a report can show it; none of it changes the mesh.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct ReadNotes {
+    /// Lines skipped as unknown or unused: OBJ lines other than `v`, `vt`, `vn`, `f`,
+    /// `o`, `g`, `usemtl`, `mtllib`, comments and blank lines (so `l`, `p`, `s`, `vp`,
+    /// curve and surface statements, and unknown keywords); PLY header lines with a
+    /// keyword the format does not define; ASCII STL lines holding a word outside STL's
+    /// grammar; OFF lines after the last face. Default 0.
+    pub skipped_lines: usize,
+    /// PLY properties the reader does not use, counted once per declaration in the
+    /// header: everything but `x`, `y`, `z` of the vertex element and the index list of
+    /// the face element (colours, normals, texture coordinates, properties of other
+    /// elements). Default 0.
+    pub skipped_properties: usize,
+    /// Text lines holding bytes that are not UTF-8 (in names and comments; Latin-1
+    /// material names are common), read as bytes. Default 0.
+    pub non_utf8_lines: usize,
+    /// Whether the data began with a UTF-8 byte order mark (`EF BB BF`), which was
+    /// skipped. Default `false`.
+    pub byte_order_mark: bool,
+}
+
+impl ReadNotes {
+    /// Whether the reader passed over anything at all.
+    pub fn is_empty(&self) -> bool {
+        *self == ReadNotes::default()
+    }
+}
+
+/// The UTF-8 byte order mark some Windows tools put before text.
+const BOM: &[u8] = b"\xEF\xBB\xBF";
+
+/// `bytes` without a leading UTF-8 byte order mark, and whether there was one.
+pub(crate) fn strip_bom(bytes: &[u8]) -> (&[u8], bool) {
+    match bytes.strip_prefix(BOM) {
+        Some(rest) => (rest, true),
+        None => (bytes, false),
+    }
 }
 
 /// Reads mesh data in `format` from memory. Gzip data (magic bytes `1f 8b`) is
@@ -193,21 +257,26 @@ fn read_plain(bytes: &[u8], format: Format) -> Result<LoadedMesh, ReadError> {
     if bytes.is_empty() {
         return Err(ReadError::new(ReadErrorKind::Empty, None));
     }
-    let loaded = match format {
-        Format::Obj => obj::read(bytes)?,
-        Format::Ply => LoadedMesh {
-            mesh: ply::read(bytes)?,
-            obj: None,
-        },
-        Format::Stl => LoadedMesh {
-            mesh: stl::read(bytes)?,
-            obj: None,
-        },
-        Format::Off => LoadedMesh {
-            mesh: off::read(bytes)?,
-            obj: None,
-        },
+    let mut notes = ReadNotes::default();
+    // A byte order mark is text's; binary STL's 80-byte header may start with any
+    // bytes, so the STL reader decides for itself once it knows which form it reads.
+    let text = if format == Format::Stl {
+        bytes
+    } else {
+        let (rest, bom) = strip_bom(bytes);
+        notes.byte_order_mark = bom;
+        rest
     };
+    let (mesh, obj) = match format {
+        Format::Obj => {
+            let (mesh, attrs) = obj::read(text, &mut notes)?;
+            (mesh, Some(attrs))
+        }
+        Format::Ply => (ply::read(text, &mut notes)?, None),
+        Format::Stl => (stl::read(text, &mut notes)?, None),
+        Format::Off => (off::read(text, &mut notes)?, None),
+    };
+    let loaded = LoadedMesh { mesh, obj, notes };
     // The parsers report most problems with a place; this is the safety net that makes
     // the documented guarantee hold whatever they missed.
     loaded
@@ -314,7 +383,8 @@ pub fn write_to<W: Write>(out: W, mesh: &IndexedMesh, format: Format) -> std::io
 ///
 /// The data goes to a new temporary file in the same directory, which is flushed to
 /// disk and then renamed over `path`; on any error the temporary file is removed, so
-/// `path` either keeps its old content or gets the complete new one.
+/// `path` either keeps its old content or gets the complete new one
+/// ([`write_atomically`]).
 pub fn write_path(path: &Path, mesh: &IndexedMesh) -> Result<(), IoError> {
     let format = Format::from_path(path).map_err(|source| IoError::Read {
         path: path.to_path_buf(),
@@ -324,59 +394,16 @@ pub fn write_path(path: &Path, mesh: &IndexedMesh) -> Result<(), IoError> {
         .file_name()
         .and_then(|n| n.to_str())
         .is_some_and(|n| strip_gz(n).is_some());
-    let file_err = |action, source| IoError::File {
-        path: path.to_path_buf(),
-        action,
-        source,
-    };
-    let (tmp, file) = create_temp_beside(path).map_err(|e| file_err("create a file beside", e))?;
-    let result = (|| -> std::io::Result<()> {
-        let file = if gz {
+    write_atomically(path, |file| {
+        if gz {
             let mut enc = flate2::write::GzEncoder::new(file, flate2::Compression::default());
             write_to(&mut enc, mesh, format)?;
-            enc.finish()?
+            enc.finish()?;
+            Ok(())
         } else {
-            let mut file = file;
-            write_to(&mut file, mesh, format)?;
-            file
-        };
-        file.sync_all()
-    })();
-    let result = result
-        .map_err(|e| file_err("write", e))
-        .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| file_err("rename into", e)));
-    if result.is_err() {
-        // Best effort: the error being reported is the one that matters.
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
-}
-
-/// Creates a fresh file next to `path` named `.NAME.qem-tmp-PID-N`.
-fn create_temp_beside(path: &Path) -> std::io::Result<(PathBuf, std::fs::File)> {
-    use std::sync::atomic::{AtomicU64, Ordering};
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    loop {
-        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-        let tmp = dir.join(format!(".{name}.qem-tmp-{}-{n}", std::process::id()));
-        match std::fs::OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(&tmp)
-        {
-            Ok(f) => return Ok((tmp, f)),
-            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
-            Err(e) => return Err(e),
+            write_to(file, mesh, format)
         }
-    }
+    })
 }
 
 /// What `bytes` look like, for error messages when they are not the claimed format.

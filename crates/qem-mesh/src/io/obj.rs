@@ -18,12 +18,23 @@
 //! past the start of a texture-coordinate or normal list overflows an index computation,
 //! which panics in debug builds; index `0` in a `vt`/`vn` slot is silently treated as
 //! "absent"). So the reader first scans the bytes itself and reports, with the line:
-//! non-UTF-8 text outside comments (comments that are not UTF-8, and bare `usemtl`
-//! lines, which tobj refuses, are blanked before tobj sees them), `v` lines without three numbers or with a
-//! non-finite coordinate or a zero `w`, `vt` and `vn` lines without enough numbers,
-//! and every face index that is not an integer, is 0, points before the first element
-//! or past the last one of its list. Whatever `tobj` still refuses is reported with its
-//! own message and no line.
+//! bytes that are not UTF-8 on a `v`, `vt`, `vn`, `f` or `l` line, `v` lines without
+//! three numbers or with a non-finite coordinate or a zero `w`, `vt` and `vn` lines
+//! without enough numbers, and every face index that is not an integer, is 0, points
+//! before the first element or past the last one of its list. Whatever `tobj` still
+//! refuses is reported with its own message and no line.
+//!
+//! # Lenient where the geometry is not at stake
+//! Everything else may hold any bytes: comments, names and unknown lines. `tobj` reads
+//! only UTF-8, so before it sees the text the reader blanks (overwrites with spaces, in
+//! a copy, keeping every offset) comments and `usemtl`/`mtllib`/unknown lines that are
+//! not UTF-8, the name of an `o`/`g` line that is not (the keyword stays: `tobj` starts
+//! a new model there), `usemtl` lines `tobj` refuses (bare, or with a tab before the
+//! name) and unknown lines with non-ASCII bytes (where `tobj`'s Unicode whitespace and
+//! the scan's ASCII whitespace could disagree about the keyword). Names are kept byte
+//! for byte in [`ObjAttributes`]; skipped lines and lines that are not UTF-8 are
+//! counted in [`ReadNotes`]. A UTF-8 byte order mark is skipped (by
+//! [`read_bytes`](super::read_bytes)); `\r\n` line ends and tabs are whitespace.
 //!
 //! Line continuations (`\\` at the end of a line) are joined before both.
 //!
@@ -34,14 +45,23 @@
 use std::io::Write;
 
 use super::text::{self, parse_f64, parse_i64, show, words};
-use super::{sniff, Format, LoadedMesh, Location, ReadError};
+use std::collections::HashSet;
+
+use super::{sniff, Format, Location, ReadError, ReadNotes};
 use crate::{IndexedMesh, InputError};
 
-/// Texture coordinates and normals of an OBJ file, indexed per triangle corner.
+/// Texture coordinates and normals of an OBJ file, indexed per triangle corner, and the
+/// names it carries.
 ///
 /// `texcoord_indices` and `normal_indices` are either empty (the file has none) or hold
-/// one entry per triangle of [`LoadedMesh::mesh`], in the same order; a corner without
-/// a texture coordinate or normal holds [`ObjAttributes::MISSING`].
+/// one entry per triangle of [`LoadedMesh::mesh`](super::LoadedMesh::mesh), in the
+/// same order; a corner without a texture coordinate or normal holds
+/// [`ObjAttributes::MISSING`].
+///
+/// Names are kept byte for byte (OBJ does not say how names are encoded, and Latin-1
+/// names are common in CAD exports): each is the rest of its line after the keyword,
+/// without the ASCII whitespace around it, listed once, in order of first appearance.
+/// Which faces a name applies to is not kept (yet).
 #[derive(Clone, Debug, Default, PartialEq)]
 #[non_exhaustive]
 pub struct ObjAttributes {
@@ -53,6 +73,12 @@ pub struct ObjAttributes {
     pub texcoord_indices: Vec<[u32; 3]>,
     /// Per triangle corner, an index into `normals`.
     pub normal_indices: Vec<[u32; 3]>,
+    /// Names of `o` and `g` lines.
+    pub groups: Vec<Vec<u8>>,
+    /// Names of `usemtl` lines.
+    pub materials: Vec<Vec<u8>>,
+    /// File names of `mtllib` lines (not opened).
+    pub material_libraries: Vec<Vec<u8>>,
 }
 
 impl ObjAttributes {
@@ -77,15 +103,59 @@ fn keyword(line: &[u8]) -> (&[u8], &[u8]) {
     (&line[..end], &line[end..])
 }
 
-/// The scan described in the module docs. Returns the byte ranges of lines to blank
-/// out before `tobj` sees the text: comments that are not UTF-8 (tobj would refuse the
-/// whole file) and bare `usemtl` lines (tobj refuses them; they mean "no material").
+/// What the first scan found besides errors: the lines to blank before `tobj` sees
+/// the text, the names, and the notes.
+#[derive(Default)]
+struct Scan {
+    /// Byte ranges to overwrite with spaces in the copy given to `tobj`.
+    blank: Vec<std::ops::Range<usize>>,
+    names: Names,
+    notes: ReadNotes,
+}
+
+/// Distinct names in order of first appearance (the set only answers "seen?").
+#[derive(Default)]
+struct Names {
+    groups: Vec<Vec<u8>>,
+    materials: Vec<Vec<u8>>,
+    libraries: Vec<Vec<u8>>,
+    seen: [HashSet<Vec<u8>>; 3],
+}
+
+impl Names {
+    fn add(&mut self, which: usize, name: &[u8]) {
+        if name.is_empty() || self.seen[which].contains(name) {
+            return;
+        }
+        self.seen[which].insert(name.to_vec());
+        let list = match which {
+            0 => &mut self.groups,
+            1 => &mut self.materials,
+            _ => &mut self.libraries,
+        };
+        list.push(name.to_vec());
+    }
+}
+
+/// Whether `tobj` refuses this `usemtl` line: it takes the name after the first space
+/// (not tab) and refuses an empty one. Materials are never loaded, so for `tobj` every
+/// `usemtl` line is a no-op and blanking one changes nothing else.
+fn tobj_refuses_usemtl(line: &[u8]) -> bool {
+    match std::str::from_utf8(line) {
+        Ok(l) => l
+            .split_once(' ')
+            .is_none_or(|(_, name)| name.trim().is_empty()),
+        Err(_) => true,
+    }
+}
+
+/// The scan described in the module docs.
 ///
-/// With `detailed == false` only what guards `tobj` is checked (text, face indices:
-/// not 0, not before the start, not absurdly large); the detailed scan also checks the
-/// numbers of `v`/`vt`/`vn` lines and indices against the file's totals, and runs only
-/// when `tobj` or validation has refused the data, to say where.
-fn prescan(bytes: &[u8], detailed: bool) -> Result<Vec<std::ops::Range<usize>>, ReadError> {
+/// With `detailed == false` only what guards `tobj` is checked (text of geometry lines,
+/// face indices: not 0, not before the start, not absurdly large); the detailed scan
+/// also checks the numbers of `v`/`vt`/`vn` lines and indices against the file's
+/// totals, and runs only when `tobj` or validation has refused the data, to say where.
+fn prescan(bytes: &[u8], detailed: bool) -> Result<Scan, ReadError> {
     if let Some(other) = sniff(bytes).filter(|&s| s != "an OBJ file") {
         return Err(ReadError::not_this_format(
             Format::Obj,
@@ -112,7 +182,7 @@ fn prescan(bytes: &[u8], detailed: bool) -> Result<Vec<std::ops::Range<usize>>, 
     }
     let mut so_far = Counts::default();
     let mut faces = 0usize;
-    let mut blank = Vec::new();
+    let mut scan = Scan::default();
     // One check of the whole text is much cheaper than one per line.
     let all_utf8 = std::str::from_utf8(bytes).is_ok();
     for (no, line) in text::lines(bytes) {
@@ -120,16 +190,20 @@ fn prescan(bytes: &[u8], detailed: bool) -> Result<Vec<std::ops::Range<usize>>, 
         let (key, rest) = keyword(line);
         // Offset of the line in `bytes` (both are views of the same buffer).
         let start = line.as_ptr() as usize - bytes.as_ptr() as usize;
+        let whole = start..start + line.len();
+        let utf8_error = (!all_utf8)
+            .then(|| std::str::from_utf8(line).err())
+            .flatten();
+        scan.notes.non_utf8_lines += usize::from(utf8_error.is_some());
         if key.first() == Some(&b'#') {
-            if !all_utf8 && std::str::from_utf8(line).is_err() {
-                blank.push(start..start + line.len());
+            if utf8_error.is_some() {
+                scan.blank.push(whole);
             }
             continue;
         }
-        if let Some(e) = (!all_utf8)
-            .then(|| std::str::from_utf8(line).err())
-            .flatten()
-        {
+        let is_geometry = matches!(key, b"v" | b"vt" | b"vn" | b"f" | b"l");
+        if let Some(e) = utf8_error.filter(|_| is_geometry) {
+            // Geometry stays strict: a byte that is not text cannot be a number.
             return Err(ReadError::malformed(
                 at,
                 format!(
@@ -211,12 +285,42 @@ fn prescan(bytes: &[u8], detailed: bool) -> Result<Vec<std::ops::Range<usize>>, 
                     check_corner(corner, faces, so_far, total, at)?;
                 }
                 faces += usize::from(key == b"f");
+                // Lines and points are read (their indices guard tobj) but not kept.
+                scan.notes.skipped_lines += usize::from(key == b"l");
             }
-            b"usemtl" if words(rest).next().is_none() => blank.push(start..start + line.len()),
-            _ => {}
+            b"o" | b"g" => {
+                scan.names.add(0, text::trim(rest));
+                // `tobj` starts a new model at every `o`/`g` line, which decides the
+                // vertex order: keep the keyword, hide a name it cannot take as text.
+                if utf8_error.is_some() {
+                    scan.blank.push(start + line.len() - rest.len()..whole.end);
+                }
+            }
+            b"usemtl" => {
+                scan.names.add(1, text::trim(rest));
+                if utf8_error.is_some() || tobj_refuses_usemtl(line) {
+                    scan.blank.push(whole);
+                }
+            }
+            b"mtllib" => {
+                scan.names.add(2, text::trim(rest));
+                if utf8_error.is_some() {
+                    scan.blank.push(whole);
+                }
+            }
+            b"" => {}
+            _ => {
+                scan.notes.skipped_lines += 1;
+                // `tobj` splits words at Unicode whitespace and this scan at ASCII
+                // whitespace; a line the scan does not know is hidden from `tobj` when
+                // they could disagree (e.g. "v\u{a0}1 2 3"), so both skip it.
+                if utf8_error.is_some() || !line.is_ascii() {
+                    scan.blank.push(whole);
+                }
+            }
         }
     }
-    Ok(blank)
+    Ok(scan)
 }
 
 /// Whether a face line's corners are all `a[/[b][/c]]` with positive indices of at
@@ -308,20 +412,23 @@ fn check_corner(
     Ok(())
 }
 
-pub(crate) fn read(bytes: &[u8]) -> Result<LoadedMesh, ReadError> {
+pub(crate) fn read(
+    bytes: &[u8],
+    notes: &mut ReadNotes,
+) -> Result<(IndexedMesh, ObjAttributes), ReadError> {
     // tobj does not know line continuations ("\\" at the end of a line, used for
     // long faces); join them first, keeping byte offsets, and remember where.
     let (joined, joins) = join_continuations(bytes);
     let source: &[u8] = joined.as_deref().unwrap_or(bytes);
     let located = |e| physical_line(e, source, &joins);
-    let blank = prescan(source, false).map_err(located)?;
+    let scan = prescan(source, false).map_err(located)?;
     let owned;
-    let text: &[u8] = if blank.is_empty() {
+    let text: &[u8] = if scan.blank.is_empty() {
         source
     } else {
         let mut copy = source.to_vec();
-        for r in blank {
-            if let Some(line) = copy.get_mut(r) {
+        for r in &scan.blank {
+            if let Some(line) = copy.get_mut(r.clone()) {
                 line.fill(b' ');
             }
         }
@@ -351,13 +458,21 @@ pub(crate) fn read(bytes: &[u8]) -> Result<LoadedMesh, ReadError> {
                 ));
             }
         };
-    let loaded = assemble(&models);
-    if let Err(e) = loaded.mesh.validate() {
+    let (mesh, mut attrs) = assemble(&models);
+    if let Err(e) = mesh.validate() {
         // Say where, when the detailed scan can (e.g. a non-finite coordinate).
         prescan(source, true).map_err(located)?;
         return Err(ReadError::mesh(None, e));
     }
-    Ok(loaded)
+    let Scan {
+        names, notes: n, ..
+    } = scan;
+    attrs.groups = names.groups;
+    attrs.materials = names.materials;
+    attrs.material_libraries = names.libraries;
+    notes.skipped_lines += n.skipped_lines;
+    notes.non_utf8_lines += n.non_utf8_lines;
+    Ok((mesh, attrs))
 }
 
 /// Replaces every `\\` that ends a line, and the line break after it, by spaces.
@@ -406,7 +521,7 @@ fn physical_line(e: ReadError, joined: &[u8], joins: &[usize]) -> ReadError {
 }
 
 /// Concatenates tobj's models into one mesh with attributes.
-fn assemble(models: &[tobj::Model]) -> LoadedMesh {
+fn assemble(models: &[tobj::Model]) -> (IndexedMesh, ObjAttributes) {
     let mut mesh = IndexedMesh::default();
     let mut attrs = ObjAttributes::default();
     let any_tex = models.iter().any(|m| !m.mesh.texcoord_indices.is_empty());
@@ -442,10 +557,7 @@ fn assemble(models: &[tobj::Model]) -> LoadedMesh {
             push_corners(&mut attrs.normal_indices, &m.normal_indices, nbase, ntri);
         }
     }
-    LoadedMesh {
-        mesh,
-        obj: Some(attrs),
-    }
+    (mesh, attrs)
 }
 
 /// Appends `ntri` corner triples from `src` offset by `base`, or MISSING when `src`

@@ -5,14 +5,18 @@
 //! skipped), then `vertices faces [edges]` (on the header line or the next one), one
 //! vertex per line, then one face per line as `n i1 .. in [colour]`. `#` starts a
 //! comment. `4OFF`, `nOFF` and `OFF BINARY` are refused with a clear error.
+//!
+//! Comments may hold any bytes (they are counted in [`ReadNotes::non_utf8_lines`] when
+//! they are not UTF-8); numbers must be numbers. Lines after the last face are skipped
+//! and counted in [`ReadNotes::skipped_lines`].
 
 use std::io::Write;
 
 use super::text::{self, capacity_for, parse_f64, parse_i64, show, words};
-use super::{sniff, Format, Location, ReadError};
+use super::{sniff, Format, Location, ReadError, ReadNotes};
 use crate::{IndexedMesh, InputError, MAX_ELEMENTS};
 
-pub(crate) fn read(bytes: &[u8]) -> Result<IndexedMesh, ReadError> {
+pub(crate) fn read(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, ReadError> {
     let mut lines = text::lines(bytes)
         .map(|(no, l)| (no, text::trim(text::strip_comment(l, b'#'))))
         .filter(|(_, l)| !l.is_empty());
@@ -158,6 +162,8 @@ pub(crate) fn read(bytes: &[u8]) -> Result<IndexedMesh, ReadError> {
         }
         fan(&corners, &mut triangles);
     }
+    notes.skipped_lines += lines.count();
+    notes.non_utf8_lines += text::non_utf8_lines(bytes);
     Ok(IndexedMesh::new(positions, triangles))
 }
 

@@ -4,7 +4,14 @@
 //! must have scalar `x`, `y`, `z` properties (any numeric type; `float` and `double`
 //! are usual); the `face` element must have an integer list `vertex_indices` or
 //! `vertex_index` (any integer count and item types). Every other element and
-//! property, lists included, is skipped. Polygons are fan-triangulated.
+//! property, lists included, is skipped (and counted in
+//! [`ReadNotes::skipped_properties`]). Polygons are fan-triangulated.
+//!
+//! Header lines are read as bytes: comments and names may hold any bytes (counted in
+//! [`ReadNotes::non_utf8_lines`] when not UTF-8), and a line whose keyword the format
+//! does not define (`comment`, `obj_info`, `format`, `element`, `property`,
+//! `end_header`) is skipped and counted in [`ReadNotes::skipped_lines`]. Types, counts
+//! and numbers stay strict: they decide where the geometry is.
 //!
 //! Writes `binary_little_endian` with `double` coordinates (so positions read back
 //! exactly) and `list uchar int vertex_indices`.
@@ -13,7 +20,7 @@ use std::io::Write;
 
 use super::off::fan;
 use super::text::{self, capacity_for, parse_f64, parse_i64, show, Tokens};
-use super::{sniff, Format, Location, ReadError};
+use super::{sniff, Format, Location, ReadError, ReadNotes};
 use crate::{IndexedMesh, InputError, MAX_ELEMENTS};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -87,7 +94,7 @@ struct Header<'a> {
     body_line: usize,
 }
 
-fn parse_header(bytes: &[u8]) -> Result<Header<'_>, ReadError> {
+fn parse_header<'a>(bytes: &'a [u8], notes: &mut ReadNotes) -> Result<Header<'a>, ReadError> {
     if !(bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n")) {
         return Err(ReadError::not_this_format(
             Format::Ply,
@@ -207,12 +214,9 @@ fn parse_header(bytes: &[u8]) -> Result<Header<'_>, ReadError> {
                     body_line: no + 1,
                 });
             }
-            other => {
-                return Err(ReadError::malformed(
-                    at,
-                    format!("unknown PLY header keyword {}", show(other)),
-                ))
-            }
+            // A keyword PLY does not define: an exporter's extension. Skipping it is
+            // what other readers do; the count in the notes shows it happened.
+            _ => notes.skipped_lines += 1,
         }
     }
     Err(ReadError::truncated(
@@ -348,8 +352,9 @@ impl Builder {
     }
 }
 
-pub(crate) fn read(bytes: &[u8]) -> Result<IndexedMesh, ReadError> {
-    let header = parse_header(bytes)?;
+pub(crate) fn read(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, ReadError> {
+    let header = parse_header(bytes, notes)?;
+    notes.non_utf8_lines += text::non_utf8_lines(bytes.get(..header.body).unwrap_or_default());
     let body = bytes.get(header.body..).unwrap_or_default();
     let mut b = Builder {
         positions: Vec::new(),
@@ -368,7 +373,9 @@ pub(crate) fn read(bytes: &[u8]) -> Result<IndexedMesh, ReadError> {
                 let is_face = el.name == b"face" && !seen_face;
                 seen_vertex |= is_vertex;
                 seen_face |= is_face;
-                read_ascii_element(&mut tok, el, &roles(el, is_vertex, is_face)?, &mut b)?;
+                let roles = roles(el, is_vertex, is_face)?;
+                notes.skipped_properties += skipped(&roles);
+                read_ascii_element(&mut tok, el, &roles, &mut b)?;
                 if is_vertex {
                     b.vertex_count = Some(b.positions.len());
                 }
@@ -386,7 +393,9 @@ pub(crate) fn read(bytes: &[u8]) -> Result<IndexedMesh, ReadError> {
                 let is_face = el.name == b"face" && !seen_face;
                 seen_vertex |= is_vertex;
                 seen_face |= is_face;
-                read_binary_element(&mut cur, el, &roles(el, is_vertex, is_face)?, &mut b)?;
+                let roles = roles(el, is_vertex, is_face)?;
+                notes.skipped_properties += skipped(&roles);
+                read_binary_element(&mut cur, el, &roles, &mut b)?;
                 if is_vertex {
                     b.vertex_count = Some(b.positions.len());
                 }
@@ -394,6 +403,11 @@ pub(crate) fn read(bytes: &[u8]) -> Result<IndexedMesh, ReadError> {
         }
     }
     Ok(IndexedMesh::new(b.positions, b.triangles))
+}
+
+/// How many properties of an element the reader skips.
+fn skipped(roles: &[Role]) -> usize {
+    roles.iter().filter(|r| matches!(r, Role::Skip)).count()
 }
 
 fn plural(name: &[u8]) -> String {

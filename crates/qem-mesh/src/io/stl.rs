@@ -6,17 +6,22 @@
 //! is ASCII. Each facet gives three new vertices: STL has no shared vertices and the
 //! reader does not weld (that is the cleaning stage's job). ASCII facets with more than
 //! three vertices are fan-triangulated.
+//!
+//! ASCII STL's names (after `solid` and `endsolid`) may hold any bytes, a UTF-8 byte
+//! order mark before `solid` is skipped, and words outside the grammar (`facet normal
+//! outer loop vertex endloop endfacet` and numbers) are skipped, their lines counted in
+//! [`ReadNotes::skipped_lines`]. A coordinate after `vertex` must be a number.
 
 use std::io::Write;
 
 use super::text::{parse_f64, show, Tokens};
-use super::{sniff, Format, Location, ReadError};
+use super::{sniff, strip_bom, Format, Location, ReadError, ReadNotes};
 use crate::{IndexedMesh, InputError, MAX_ELEMENTS};
 
 const HEADER: usize = 84;
 const RECORD: usize = 50;
 
-pub(crate) fn read(bytes: &[u8]) -> Result<IndexedMesh, ReadError> {
+pub(crate) fn read(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, ReadError> {
     let count = bytes
         .get(80..84)
         .and_then(|b| b.try_into().ok())
@@ -26,11 +31,15 @@ pub(crate) fn read(bytes: &[u8]) -> Result<IndexedMesh, ReadError> {
             return read_binary(bytes, n as usize);
         }
     }
-    let looks_like = sniff(bytes);
-    let head = &bytes[..bytes.len().min(1024)];
+    // Not binary by size: a byte order mark can only be text's.
+    let (text, bom) = strip_bom(bytes);
+    let looks_like = sniff(text);
+    let head = &text[..text.len().min(1024)];
     let textual = !head.contains(&0);
     if looks_like == Some("an ASCII STL file") && textual {
-        return read_ascii(bytes);
+        notes.byte_order_mark = bom;
+        notes.non_utf8_lines += super::text::non_utf8_lines(text);
+        return read_ascii(text, notes);
     }
     match (count, looks_like) {
         (Some(n), None | Some("an ASCII STL file") | Some("binary data")) => {
@@ -108,8 +117,10 @@ fn read_binary(bytes: &[u8], n: usize) -> Result<IndexedMesh, ReadError> {
     Ok(IndexedMesh::new(positions, triangles))
 }
 
-fn read_ascii(bytes: &[u8]) -> Result<IndexedMesh, ReadError> {
+fn read_ascii(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, ReadError> {
     let mut tok = Tokens::new(bytes, 1);
+    // The last line counted in `notes.skipped_lines`, so a line is counted once.
+    let mut skipped_line = 0usize;
     let mut positions: Vec<[f64; 3]> = Vec::new();
     let mut triangles = Vec::new();
     // Index in `positions` of the current facet's first vertex, while inside a facet.
@@ -183,6 +194,13 @@ fn read_ascii(bytes: &[u8]) -> Result<IndexedMesh, ReadError> {
                 triangles.push([a, k as u32, k as u32 + 1]);
             }
             facets += 1;
+        } else if !(is(b"normal") || is(b"outer") || is(b"loop") || is(b"endloop"))
+            && parse_f64(word).is_none()
+            && skipped_line != line
+        {
+            // Not STL: an exporter's extension or junk. It has no say in the geometry.
+            notes.skipped_lines += 1;
+            skipped_line = line;
         }
         // "normal", its three numbers, "outer", "loop" and "endloop" carry nothing we keep.
     }

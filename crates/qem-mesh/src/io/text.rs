@@ -17,6 +17,17 @@ pub(crate) fn lines(data: &[u8]) -> impl Iterator<Item = (usize, &[u8])> {
     })
 }
 
+/// How many lines of `data` are not valid UTF-8 (one check of the whole text first:
+/// nearly every file is, and that is much cheaper than a check per line).
+pub(crate) fn non_utf8_lines(data: &[u8]) -> usize {
+    if std::str::from_utf8(data).is_ok() {
+        return 0;
+    }
+    lines(data)
+        .filter(|(_, l)| std::str::from_utf8(l).is_err())
+        .count()
+}
+
 /// `s` without leading ASCII whitespace.
 pub(crate) fn trim_start(s: &[u8]) -> &[u8] {
     let i = s
