@@ -46,7 +46,7 @@ fn main() {
         best = best.min(t.elapsed().as_secs_f64());
         best_loop = best_loop.min(out.report.timings.contract.as_secs_f64());
         let r = &out.report;
-        eprintln!("{} tris, {:.3} s, loop {:.3} s, contractions {}, rejected: degenerate {} flip {} sliver {} topology {} locked {} border {}", out.mesh.triangle_count(), t.elapsed().as_secs_f64(), r.timings.contract.as_secs_f64(), r.edge_contractions + r.virtual_contractions, r.rejected_degenerate, r.rejected_flip, r.rejected_sliver, r.rejected_topology, r.rejected_locked, r.rejected_border);
+        eprintln!("{} tris, {:.3} s, loop {:.3} s, contractions {}, rejected: degenerate {} flip {} sliver {} topology {} locked {} border {}", out.mesh.triangle_count(), t.elapsed().as_secs_f64(), r.timings.contract.as_secs_f64(), r.edge_contractions + r.virtual_contractions, r.rejected.degenerate, r.rejected.flip, r.rejected.sliver, r.rejected.topology, r.rejected.locked, r.rejected.border);
     }
     println!("{mode}: best total {best:.3} s, best loop {best_loop:.3} s");
 }

@@ -89,7 +89,7 @@ fn corpus_scans_have_no_face_against_the_nearest_input_face_at_ratio_0_1() {
             0,
             "{name}: faces against the input with the check on"
         );
-        assert!(checked.report.rejected_orientation > 0, "{name}");
+        assert!(checked.report.rejected.orientation > 0, "{name}");
         assert_eq!(
             checked.report.stop_reason,
             StopReason::TargetReached,
@@ -98,7 +98,7 @@ fn corpus_scans_have_no_face_against_the_nearest_input_face_at_ratio_0_1() {
 
         let unchecked = simplify(&mesh, &options.clone().with_orientation_check(false))
             .unwrap_or_else(|e| panic!("{name}: {e}"));
-        assert_eq!(unchecked.report.rejected_orientation, 0);
+        assert_eq!(unchecked.report.rejected.orientation, 0);
         unchecked_flipped += flipped_against_nearest_input(&mesh, &unchecked.mesh);
     }
     if meshes == 2 {

@@ -183,7 +183,7 @@ fn too_many_locked_vertices_stop_the_run_short() {
     check_run(&out, n);
     assert_eq!(out.report.stop_reason, StopReason::NoValidPair);
     assert!(out.mesh.triangle_count() >= 2 * locked.len() - 4);
-    assert!(out.report.rejected_locked > 0);
+    assert!(out.report.rejected.locked > 0);
     let present = position_bits(&out.mesh);
     for &v in &locked {
         let p = sphere.positions[v as usize].map(f64::to_bits);
@@ -201,7 +201,7 @@ fn all_vertices_locked_is_a_no_op() {
     check_run(&out, sphere.triangle_count());
     assert_eq!(out.report.stop_reason, StopReason::NoValidPair);
     assert_eq!(out.report.edge_contractions, 0);
-    assert!(out.report.rejected_locked > 0);
+    assert!(out.report.rejected.locked > 0);
     assert_eq!(bits(&out.mesh), bits(&sphere));
 }
 
@@ -250,10 +250,10 @@ fn the_orientation_check_stops_flips_and_the_run_still_reaches_its_target() {
     };
     let (unchecked, checked) = (at(0.1, false), at(0.1, true));
     assert!(unchecked.faces_flipped > 0);
-    assert_eq!(unchecked.rejected_orientation, 0, "the check was off");
+    assert_eq!(unchecked.rejected.orientation, 0, "the check was off");
     assert_eq!(checked.faces_flipped, 0);
-    assert!(checked.rejected_orientation > 0);
-    assert!(at(0.02, true).rejected_orientation > 0);
+    assert!(checked.rejected.orientation > 0);
+    assert!(at(0.02, true).rejected.orientation > 0);
 }
 
 // Every option works in both orders: topology preservation keeps a torus a torus
@@ -655,7 +655,7 @@ fn messy_corpus_meshes_at_ratio_0_1() {
         assert_eq!(r.stop_reason, stop_reason, "{name}");
         if let Some(count) = triangles_out {
             assert_eq!(r.triangles_out, count, "{name}");
-            assert!(r.rejected_merge > 0, "{name}");
+            assert!(r.rejected.merge > 0, "{name}");
         }
         assert_eq!(r.faces_flipped, 0, "{name}");
         assert_eq!(
@@ -688,7 +688,7 @@ fn orientation_refusals_are_waived_on_the_mannequin_at_0_01() {
     check_run(&out, mesh.triangle_count());
     let r = &out.report;
     assert_eq!(r.stop_reason, StopReason::TargetReached);
-    assert!(r.rejected_orientation > 0);
+    assert!(r.rejected.orientation > 0);
     assert!(
         r.max_error < 0.02,
         "largest error {:.4}% of the diagonal",
@@ -775,6 +775,6 @@ fn a_pass_that_only_waives_does_not_end_the_run() {
     let out = simplify(&thin, &options).unwrap();
     check_run(&out, thin.triangle_count());
     assert_eq!(out.report.stop_reason, StopReason::NoValidPair);
-    assert!(out.report.rejected_orientation > 0);
+    assert!(out.report.rejected.orientation > 0);
     assert_eq!(out.report.triangles_out, 32);
 }

@@ -32,9 +32,9 @@ fn jagged_sheet_folds_over_without_the_check_and_not_with_it() {
     let checked = simplify(&sheet, &options).unwrap();
     assert_valid(&checked.mesh, sheet.triangle_count());
     assert!(unchecked.report.faces_flipped > 0);
-    assert_eq!(unchecked.report.rejected_flip, 0, "the check was off");
+    assert_eq!(unchecked.report.rejected.flip, 0, "the check was off");
     assert_eq!(checked.report.faces_flipped, 0);
-    assert!(checked.report.rejected_flip > 0);
+    assert!(checked.report.rejected.flip > 0);
     assert_eq!(checked.report.stop_reason, StopReason::TargetReached);
 }
 
@@ -90,9 +90,9 @@ fn flat_grid_thins_evenly_without_hubs() {
         max_valence(&out.mesh)
     );
     assert!(
-        out.report.rejected_flip * 10 < out.report.edge_contractions,
+        out.report.rejected.flip * 10 < out.report.edge_contractions,
         "{} fold-over refusals for {} contractions",
-        out.report.rejected_flip,
+        out.report.rejected.flip,
         out.report.edge_contractions
     );
 }
@@ -196,7 +196,7 @@ fn slivers_never_get_worse_than_the_threshold_or_the_input() {
     let out = simplify(&sheet, &at(0.1).with_min_triangle_quality(threshold)).unwrap();
     assert_valid(&out.mesh, sheet.triangle_count());
     let min_out = qualities(&out.mesh).into_iter().fold(1.0, f64::min);
-    assert!(out.report.rejected_sliver > 0);
+    assert!(out.report.rejected.sliver > 0);
     assert!(
         min_out >= threshold.min(min_in),
         "{min_out} < min({threshold}, {min_in})"

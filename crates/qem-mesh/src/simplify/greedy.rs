@@ -3,7 +3,7 @@
 //!
 //! Every pair (edge or virtual pair) is costed once (on both cores, as a pass costs
 //! its edges) and queued ([`PairQueue`]); the cheapest is popped and attempted by the
-//! same attempt sequence as the pass-based order's ([`PassEngine::try_contract`]: lock
+//! same attempt sequence as the pass-based order's ([`Engine::try_contract`]: lock
 //! order, placement, error bound, checks, orientation and waiver, contraction,
 //! counters, event). After a contraction `b` → `a`, `b`'s triangles join `a`'s list
 //! ([`Incidence::merge`]), `b`'s pairs become `a`'s ([`PairSet::contract`]), and every
@@ -27,10 +27,10 @@ pub(super) struct Greedy {
     filled: bool,
 }
 
-impl PassEngine {
+impl Engine {
     /// Contracts in the greedy order until `target` triangles are left, the error
     /// bound, no contraction is possible, or the observer stops it.
-    pub fn run_greedy(&mut self, target: usize, observer: &mut dyn Observer) -> StopReason {
+    pub(crate) fn run_greedy(&mut self, target: usize, observer: &mut dyn Observer) -> StopReason {
         let mut greedy = std::mem::take(&mut self.greedy);
         if !greedy.filled {
             self.queue_every_pair(&mut greedy);

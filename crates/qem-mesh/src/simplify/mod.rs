@@ -19,10 +19,10 @@
 //!
 //! Submodules, one job each: `options` (what a run may do), `settings` (options become
 //! what the engine reads, in one place), `report` and `counters` (what it did),
-//! `observer` (progress, cancellation, per-contraction events), `passes` (the working
-//! mesh, its setup and the one attempt sequence; the pass-based order), `greedy` (the
-//! greedy order), `pass_blocks` (the checks on the working mesh, and the pass-based
-//! order's block workers), `incidence` (per-vertex lists that contractions merge),
+//! `observer` (progress, cancellation, per-contraction events), `engine` (the working
+//! mesh and its setup) with its children `attempt` (the one attempt sequence),
+//! `passes` and `greedy` (the two orders), `pass_blocks` (the checks on the working
+//! mesh, and the pass-based order's block workers), `incidence` (per-vertex lists that contractions merge),
 //! `pair_set` and `pair_queue` (pairs that follow contractions, and the greedy queue),
 //! `placement` (where a merged vertex goes), `pass_exact` (the bookkeeping of
 //! [`QuadricMode::Exact`]), `checks` (the fold-over rules), `orientation` (the
@@ -32,6 +32,7 @@
 
 mod checks;
 mod counters;
+mod engine;
 mod incidence;
 mod locality;
 mod nth_key;
@@ -42,7 +43,6 @@ mod pair_queue;
 mod pair_set;
 mod pass_blocks;
 mod pass_exact;
-mod passes;
 mod placement;
 mod replay;
 mod report;
@@ -56,11 +56,11 @@ pub use options::{
     DEFAULT_MIN_TRIANGLE_QUALITY, DEFAULT_WEIGHTING_MIX,
 };
 pub use replay::StoreReplay;
-pub use report::{Simplified, SimplifyError, SimplifyReport, StopReason, Timings};
+pub use report::{Refusals, Simplified, SimplifyError, SimplifyReport, StopReason, Timings};
 
 use crate::clean::{clean, CleanOptions, Cleaned};
 use crate::IndexedMesh;
-use passes::PassEngine;
+use engine::Engine;
 use qem_core::{DVec3, Frame};
 use std::time::Instant;
 
@@ -179,7 +179,7 @@ pub fn simplify_levels(
     // The orientation check's index is independent of the rest of the setup: built on
     // the other core meanwhile (deterministic either way).
     let (mut engine, input_surface) = rayon::join(
-        || PassEngine::new(&cleaned.mesh, frame, &locked, options),
+        || Engine::new(&cleaned.mesh, frame, &locked, options),
         || {
             options
                 .orientation_check
@@ -204,7 +204,7 @@ pub fn simplify_levels(
             Some(reason) => reason,
             None => match options.order {
                 ContractionOrder::Greedy => engine.run_greedy(target_triangles, observer),
-                ContractionOrder::Passes => engine.run(target_triangles, observer),
+                ContractionOrder::Passes => engine.run_passes(target_triangles, observer),
             },
         };
         if stop_reason != StopReason::TargetReached {
@@ -252,14 +252,7 @@ pub fn simplify_levels(
             stop_reason,
             cleanup,
             degenerate_faces_removed: zero_area_dropped + final_clean.report.repeated_index_faces,
-            rejected_degenerate: counters.rejected_degenerate,
-            rejected_flip: counters.rejected_flip,
-            rejected_sliver: counters.rejected_sliver,
-            rejected_topology: counters.rejected_topology,
-            rejected_locked: counters.rejected_locked,
-            rejected_border: counters.rejected_border,
-            rejected_merge: counters.rejected_merge,
-            rejected_orientation: counters.rejected_orientation,
+            rejected: counters.rejected,
             locked_vertices: counters.locked_vertices,
             faces_flipped: engine.flipped_faces(),
             timings,

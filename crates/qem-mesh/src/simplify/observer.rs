@@ -48,6 +48,8 @@ pub struct Contraction {
     /// The same position in model units, as the output holds it (bit for bit where
     /// the kept vertex was, when an end is locked).
     pub world: [f64; 3],
+    /// How many triangles the contraction removed (those on both ends).
+    pub triangles_removed: usize,
     /// `quadric` evaluated at the chosen position (clamped to be non-negative).
     pub cost: f64,
 }

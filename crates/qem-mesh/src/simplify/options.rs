@@ -112,7 +112,7 @@ pub enum BoundaryMode {
     /// Also the *loop rule*: an edge whose two ends are on a border must be a border
     /// edge itself, and may not close a loop of three border edges, so border loops are
     /// never pinched, merged or closed (counted in
-    /// [`SimplifyReport::rejected_border`](super::SimplifyReport::rejected_border)).
+    /// [`Refusals::border`](super::Refusals::border)).
     Planes(f64),
     /// Border vertices never move and are never removed, like [locked
     /// vertices](SimplifyOptions::locked_vertices): the border comes out exactly as it
@@ -218,13 +218,13 @@ pub struct SimplifyOptions {
     /// many degrees, or that leaves it pointing more than 90° away from the input face
     /// it descends from (a fold-over in several small steps); 180 or more turns the
     /// check off (zero-area faces are refused regardless). Counted in
-    /// [`SimplifyReport::rejected_flip`](super::SimplifyReport::rejected_flip).
+    /// [`Refusals::flip`](super::Refusals::flip).
     /// Default: [`DEFAULT_MAX_NORMAL_ANGLE`] degrees.
     pub max_normal_angle: f64,
     /// Refuse a contraction that leaves a surviving face with a quality below this
     /// *and* below the face's quality before. Quality is `4√3·area / (l₀² + l₁² + l₂²)`:
     /// 1 for an equilateral triangle, 0 for a degenerate one; 0 turns the check off.
-    /// Counted in [`SimplifyReport::rejected_sliver`](super::SimplifyReport::rejected_sliver).
+    /// Counted in [`Refusals::sliver`](super::Refusals::sliver).
     /// Default: [`DEFAULT_MIN_TRIANGLE_QUALITY`].
     pub min_triangle_quality: f64,
     /// Refuse a contraction that leaves a moved face facing away from the input surface
@@ -241,7 +241,7 @@ pub struct SimplifyOptions {
     /// [`ContractionOrder::Passes`]: ranked at that cost in the later passes and
     /// contracted without the check when next attempted, unless one of its ends moves
     /// first, which has it costed and checked afresh.) Counted in
-    /// [`SimplifyReport::rejected_orientation`](super::SimplifyReport::rejected_orientation).
+    /// [`Refusals::orientation`](super::Refusals::orientation).
     /// Default: `true`.
     pub orientation_check: bool,
     /// Keep the topology: only contract edges that pass the link condition (with the

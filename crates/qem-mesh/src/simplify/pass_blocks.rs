@@ -254,7 +254,7 @@ impl<'a> Slab<'a> {
         removed
     }
 
-    /// The orientation check (see `PassEngine::faces_agree_with_input`) of moving `a`
+    /// The orientation check (see `Engine::faces_agree_with_input`) of moving `a`
     /// and `b` to `moved` (normalised units), with the slab's hints; `near` is
     /// scratch.
     fn faces_agree(
@@ -396,7 +396,7 @@ pub(super) enum WaiverChange {
 /// Attempts `pairs` (indices into `candidates`, in the round's order) on `slab`, one
 /// block; a pair that is not interior to it is deferred.
 ///
-/// The attempt is the sequential one (`PassEngine::check_and_contract`) for a run
+/// The attempt is the sequential one (`Engine::check_and_contract`) for a run
 /// without locks (the only one that uses blocks): the merged quadric (less the shared
 /// planes with exact quadrics), placement, the error bound, fold-over, merged faces,
 /// border loops, the orientation check unless the pair is waived, then the
@@ -491,7 +491,8 @@ pub(super) fn contract_block(
         if fixed.has_virtual_pairs {
             out.merges.push([a, b]);
         }
-        out.removed += slab.contract(fixed, [a, b], world, q, &around);
+        let removed = slab.contract(fixed, [a, b], world, q, &around);
+        out.removed += removed;
         out.contracted += 1;
         out.counters.edge_contractions += 1;
         out.counters.max_error = out.counters.max_error.max(error);
@@ -503,6 +504,7 @@ pub(super) fn contract_block(
                 quadric: q,
                 position: placed.position,
                 world: world.to_array(),
+                triangles_removed: removed,
                 cost: placed.cost,
             });
         }

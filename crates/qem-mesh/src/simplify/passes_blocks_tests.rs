@@ -10,8 +10,8 @@
 //! test in `Slab::gather`, `blocks_cut_through_messy_meshes` panics.)
 
 use super::speculation_tests::{
-    accordion, book, grid, noise, ratios, rough_grid, run_levels, soup, soup_options, thin_lens,
-    unwelded, Levels, Seen, Setup,
+    accordion, book, fast_with_every_quality_option, grid, noise, ratios, rough_grid, run_levels,
+    soup, soup_options, thin_lens, unwelded, Levels, Seen, Setup,
 };
 use super::*;
 use crate::simplify::PlacementMode;
@@ -65,7 +65,7 @@ fn assert_same_levels(levels: &Levels, expected: &Levels, what: &str) {
 
 /// Asserts that the blocks give what their order gives run by the sequential attempts
 /// (each round's interior pairs first, then the others, found independently of the
-/// blocks' own test; `PassEngine::interior_first`); returns what the blocks did.
+/// blocks' own test; `Engine::interior_first`); returns what the blocks did.
 fn same_as_their_order(
     mesh: &IndexedMesh,
     options: &SimplifyOptions,
@@ -161,9 +161,7 @@ fn blocks_cut_through_messy_meshes() {
 #[test]
 fn blocks_with_exact_quadrics_and_the_orientation_check() {
     let mesh = thin_lens(60, 120);
-    let options = SimplifyOptions::FAST
-        .with_quadrics(QuadricMode::Exact)
-        .with_orientation_check(true);
+    let options = fast_with_every_quality_option();
     let (_, seen) = same_on_any_thread_count(&mesh, &options, &ratios(&mesh, &[0.05]), 1_000);
     assert!(seen.block_contractions > 0 && seen.refused > 0, "{seen:?}");
 }

@@ -1,4 +1,4 @@
-//! Tests that speculating a round (`PassEngine::speculate`) gives the sequential
+//! Tests that speculating a round (`Engine::speculate`) gives the sequential
 //! order's output, bit for bit: a thin lens, with counts of reused and re-asked
 //! verdicts; then adversarial inputs, with every option the pass-based order takes
 //! and the orientation check on, through the same setup as `simplify_levels`
@@ -14,6 +14,14 @@ use proptest::prelude::*;
 /// A UV sphere squashed to a thin lens (height 0.04 of its width) with a
 /// deterministic wobble: at ratio 0.05 the rim's faces come near input faces of the
 /// other side, so the orientation check refuses pairs.
+/// `--fast --quadrics exact --orientation-check`: every default quality option in
+/// the pass-based order.
+pub(super) fn fast_with_every_quality_option() -> SimplifyOptions {
+    SimplifyOptions::FAST
+        .with_quadrics(QuadricMode::Exact)
+        .with_orientation_check(true)
+}
+
 pub(super) fn thin_lens(rings: u32, segments: u32) -> IndexedMesh {
     let mut positions = vec![[0.0, 0.0, 0.02]];
     for i in 1..rings {
@@ -58,9 +66,7 @@ pub(super) fn thin_lens(rings: u32, segments: u32) -> IndexedMesh {
 #[test]
 fn speculation_gives_the_sequential_output() {
     let mesh = thin_lens(60, 120);
-    let options = SimplifyOptions::FAST
-        .with_quadrics(QuadricMode::Exact)
-        .with_orientation_check(true);
+    let options = fast_with_every_quality_option();
     let seen = assert_same(&mesh, &options, &[mesh.triangle_count() / 20]);
     assert!(seen.refused > 0, "the check refuses some pairs");
     assert!(seen.reused > 0 && seen.asked_again > 0, "{seen:?}");
@@ -98,7 +104,7 @@ pub(super) fn run_levels(
         }
         let frame =
             Frame::from_points(cleaned.mesh.positions.iter().map(|p| DVec3::from_array(*p)));
-        let mut engine = PassEngine::new(&cleaned.mesh, frame, &locked, options);
+        let mut engine = Engine::new(&cleaned.mesh, frame, &locked, options);
         if options.orientation_check {
             let (surface, slots) = InputSurface::new(&cleaned.mesh, &frame);
             engine.set_input_surface(surface, &slots);
@@ -110,7 +116,7 @@ pub(super) fn run_levels(
         engine.probes.blocks_in_order = setup.blocks_in_order;
         let mut levels = Vec::new();
         for &target in targets {
-            let reason = engine.run(target, &mut NoObserver);
+            let reason = engine.run_passes(target, &mut NoObserver);
             let out = engine.to_mesh();
             let mut counters = engine.counters;
             let max_error = counters.max_error.to_bits();
@@ -129,7 +135,7 @@ pub(super) fn run_levels(
         let seen = Seen {
             reused: engine.probes.verdicts_reused,
             asked_again: engine.probes.verdicts_asked_again,
-            refused: engine.counters.rejected_orientation,
+            refused: engine.counters.rejected.orientation,
             block_contractions: engine.probes.block_contractions,
             block_deferrals: engine.probes.block_deferrals,
         };
@@ -145,7 +151,7 @@ pub(super) struct Setup {
     pub speculation: bool,
     pub block_vertices: Option<u32>,
     /// Instead of the blocks, their order run by the sequential attempts (see
-    /// `PassEngine::interior_first`).
+    /// `Engine::interior_first`).
     pub blocks_in_order: bool,
 }
 

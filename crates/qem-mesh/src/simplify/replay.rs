@@ -1,6 +1,7 @@
 //! The engine's oracle: an [`Observer`] that replays every contraction of a run on the
 //! radial-edge store ([`MeshStore`]), the library's model of non-manifold input, and
-//! checks that the store stays valid and that both describe the same mesh.
+//! checks after every step that the store is valid and removed the triangles the
+//! engine removed, and at the end that both hold the same triangles.
 //!
 //! The engine works on flat arrays and never builds the store; the store contracts by
 //! its own rules (faces on both ends collapse, the other faces of the removed vertex
@@ -123,12 +124,29 @@ impl Observer for StoreReplay {
         };
         let step = self.contractions;
         self.contractions += 1;
-        if let Err(e) = store.contract(a, b, c.world) {
-            self.failure = Some(format!(
-                "contraction {step} ({} into {}): the store refused it: {e}",
-                c.removed, c.kept
-            ));
-            return;
+        let faces_before = store.face_count();
+        match store.contract(a, b, c.world) {
+            Err(e) => {
+                self.failure = Some(format!(
+                    "contraction {step} ({} into {}): the store refused it: {e}",
+                    c.removed, c.kept
+                ));
+                return;
+            }
+            Ok(outcome) if outcome.faces_removed() != c.triangles_removed => {
+                self.failure = Some(format!(
+                    "contraction {step} ({} into {}): the engine removed {} triangles, \
+                     the store {} faces ({} collapsed, {} merged; {faces_before} before)",
+                    c.removed,
+                    c.kept,
+                    c.triangles_removed,
+                    outcome.faces_removed(),
+                    outcome.faces_collapsed,
+                    outcome.faces_merged
+                ));
+                return;
+            }
+            Ok(_) => {}
         }
         if let Err(e) = store.validate() {
             self.failure = Some(format!("contraction {step}: the store broke: {e}"));

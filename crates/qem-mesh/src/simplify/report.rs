@@ -93,36 +93,8 @@ pub struct SimplifyReport {
     /// Faces of the result dropped at compaction because contraction left them with
     /// zero area.
     pub degenerate_faces_removed: usize,
-    /// Contractions refused because they would have left a surviving face with zero
-    /// area.
-    pub rejected_degenerate: usize,
-    /// Contractions refused because a surviving face's normal would have turned by more
-    /// than [`max_normal_angle`](super::SimplifyOptions::max_normal_angle).
-    pub rejected_flip: usize,
-    /// Contractions refused because a surviving face would have become a sliver (below
-    /// [`min_triangle_quality`](super::SimplifyOptions::min_triangle_quality)).
-    pub rejected_sliver: usize,
-    /// Contractions refused by [`preserve_topology`](super::SimplifyOptions::preserve_topology):
-    /// link condition failed, or a non-manifold vertex or edge.
-    pub rejected_topology: usize,
-    /// Contractions refused because both vertices were locked, or because a locked
-    /// vertex would have lost its last face.
-    pub rejected_locked: usize,
-    /// Contractions refused because they would have pinched, closed or removed a border
-    /// loop (with any [`BoundaryMode`](super::BoundaryMode) but `Free`).
-    pub rejected_border: usize,
-    /// Edge contractions refused because two faces `a x y` and `b x y` would have merged
-    /// into one, which opens a hole in a closed surface (virtual pairs may merge faces:
-    /// joining parts is their purpose). With
-    /// [`preserve_topology`](super::SimplifyOptions::preserve_topology) the link condition
-    /// refuses these first, and they count in [`rejected_topology`](Self::rejected_topology).
-    pub rejected_merge: usize,
-    /// Contractions refused by the orientation check
-    /// ([`orientation_check`](super::SimplifyOptions::orientation_check)): a moved face
-    /// would have faced away from the input surface nearest to it. Such a pair is
-    /// queued again at a penalty and may be contracted later, when everything else
-    /// costs more; each refusal is counted.
-    pub rejected_orientation: usize,
+    /// Contractions refused, by reason.
+    pub rejected: Refusals,
     /// Vertices of the cleaned input that were locked (by
     /// [`locked_vertices`](super::SimplifyOptions::locked_vertices) or by
     /// [`BoundaryMode::Locked`](super::BoundaryMode::Locked)).
@@ -187,6 +159,71 @@ impl std::error::Error for SimplifyError {}
 impl From<InputError> for SimplifyError {
     fn from(e: InputError) -> Self {
         SimplifyError::Input(e)
+    }
+}
+
+/// Contractions refused, by the check that refused them (each attempt of a pair that
+/// a check refuses counts once).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Refusals {
+    /// Contractions refused because they would have left a surviving face with zero
+    /// area.
+    pub degenerate: usize,
+    /// Contractions refused because a surviving face's normal would have turned by more
+    /// than [`max_normal_angle`](super::SimplifyOptions::max_normal_angle).
+    pub flip: usize,
+    /// Contractions refused because a surviving face would have become a sliver (below
+    /// [`min_triangle_quality`](super::SimplifyOptions::min_triangle_quality)).
+    pub sliver: usize,
+    /// Contractions refused by [`preserve_topology`](super::SimplifyOptions::preserve_topology):
+    /// link condition failed, or a non-manifold vertex or edge.
+    pub topology: usize,
+    /// Contractions refused because both vertices were locked, or because a locked
+    /// vertex would have lost its last face.
+    pub locked: usize,
+    /// Contractions refused because they would have pinched, closed or removed a border
+    /// loop (with any [`BoundaryMode`](super::BoundaryMode) but `Free`).
+    pub border: usize,
+    /// Contractions refused because two faces `a x y` and `b x y` would have merged
+    /// into one, which opens a hole in a closed surface (virtual pairs may merge faces:
+    /// joining parts is their purpose). With
+    /// [`preserve_topology`](super::SimplifyOptions::preserve_topology) the link condition
+    /// refuses these first, and they count in [`topology`](Self::topology).
+    pub merge: usize,
+    /// Contractions refused by the orientation check
+    /// ([`orientation_check`](super::SimplifyOptions::orientation_check)): a moved face
+    /// would have faced away from the input surface nearest to it. Such a pair is
+    /// queued again at a penalty and may be contracted later, when everything else
+    /// costs more; each refusal is counted.
+    pub orientation: usize,
+}
+
+impl Refusals {
+    /// Every refusal, whatever the reason.
+    pub fn total(&self) -> usize {
+        let Refusals {
+            degenerate,
+            flip,
+            sliver,
+            topology,
+            locked,
+            border,
+            merge,
+            orientation,
+        } = *self;
+        degenerate + flip + sliver + topology + locked + border + merge + orientation
+    }
+
+    /// Adds `other`'s counts to these.
+    pub(crate) fn add(&mut self, other: &Refusals) {
+        self.degenerate += other.degenerate;
+        self.flip += other.flip;
+        self.sliver += other.sliver;
+        self.topology += other.topology;
+        self.locked += other.locked;
+        self.border += other.border;
+        self.merge += other.merge;
+        self.orientation += other.orientation;
     }
 }
 

@@ -1,0 +1,328 @@
+//! The one attempt of a pair, used by both orders (the pass-based order's block
+//! workers run the same steps on their slabs, [`super::super::pass_blocks`]): lock
+//! order, the guard that keeps a triangle, placement and the error bound, the world
+//! position, every check, the orientation check and its waiver, the contraction
+//! itself, the counters and the observer's event.
+
+use super::*;
+
+impl Engine {
+    /// Checks and contracts the edge `a b` (both unmoved in this pass); `live` is the
+    /// live triangle count.
+    ///
+    /// `speculation` is what [`speculate`](Self::speculate) found for the pair.
+    ///
+    /// A pair on no common triangle is a virtual pair: attempted only when
+    /// `virtual_allowed` (the greedy order's edges that lost their last triangle are
+    /// not).
+    pub(super) fn try_contract(
+        &mut self,
+        a: u32,
+        b: u32,
+        live: usize,
+        virtual_allowed: bool,
+        speculation: Option<&Speculation>,
+        observer: &mut dyn Observer,
+    ) -> Attempt {
+        let mut around = std::mem::take(&mut self.around);
+        self.gather(a, &mut around[0]);
+        self.gather(b, &mut around[1]);
+        let shared = around[0].iter().filter(|x| x.corners.contains(&b)).count();
+        if shared == 0 && !virtual_allowed {
+            self.around = around;
+            return Attempt::NotAPair;
+        }
+        let Some((kept, _)) = self.kept_first(a, b) else {
+            self.around = around;
+            self.counters.reject(Rejection::Locked);
+            return Attempt::Refused;
+        };
+        let (a, b) = if kept == a {
+            (a, b)
+        } else {
+            around.swap(0, 1);
+            (b, a)
+        };
+        // Never contract the last faces away: the output must keep a triangle.
+        let attempt = if shared >= live {
+            Attempt::Refused
+        } else {
+            self.check_and_contract(a, b, shared, &around, speculation, observer)
+        };
+        self.around = around;
+        attempt
+    }
+
+    /// The pair `a b` in the order it is contracted (the second end into the first):
+    /// a locked end is the one that stays; `None` when both are locked.
+    pub(super) fn kept_first(&self, a: u32, b: u32) -> Option<(u32, u32)> {
+        match (self.locked[a as usize], self.locked[b as usize]) {
+            (true, true) => None,
+            (false, true) => Some((b, a)),
+            _ => Some((a, b)),
+        }
+    }
+
+    /// Where contracting `b` into `a` puts the vertex, in model units: `placed`, or
+    /// `a`'s position when an end is locked or `placed` does not map to a finite point.
+    pub(super) fn world_position(&self, a: u32, placed: &Placement, any_locked: bool) -> DVec3 {
+        if any_locked {
+            // Bit for bit where it was, not a round trip through the frame.
+            return DVec3::from_array(self.world[a as usize]);
+        }
+        let world = self.frame.to_world(placed.position);
+        if world.is_finite() {
+            world
+        } else {
+            DVec3::from_array(self.world[a as usize])
+        }
+    }
+
+    /// [`try_contract`](Self::try_contract) with `around` = the live triangles of `a`
+    /// and of `b`, `shared` of which are on both.
+    fn check_and_contract(
+        &mut self,
+        a: u32,
+        b: u32,
+        shared: usize,
+        around: &[Vec<Around>; 2],
+        speculation: Option<&Speculation>,
+        observer: &mut dyn Observer,
+    ) -> Attempt {
+        let any_locked = self.locked[a as usize] || self.locked[b as usize];
+        let (placed, q) = match speculation {
+            Some(s) => {
+                debug_assert!({
+                    let (placed, q) = self.place(a, b);
+                    placed.position.to_array().map(f64::to_bits)
+                        == s.placed.position.to_array().map(f64::to_bits)
+                        && placed.cost.to_bits() == s.placed.cost.to_bits()
+                        && q.entries().map(f64::to_bits) == s.quadric.entries().map(f64::to_bits)
+                });
+                (s.placed, s.quadric)
+            }
+            None => self.place(a, b),
+        };
+        let error = q.rms_distance(placed.cost);
+        if error > self.settings.max_error_bound {
+            return Attempt::OverErrorBound;
+        }
+        let world = self.world_position(a, &placed, any_locked);
+        if let Err(why) = self.check(a, b, world, shared, around) {
+            self.counters.reject(why);
+            return Attempt::Refused;
+        }
+        // Last, as in the greedy loop: the only check that searches outside the
+        // neighbourhood. A waived pair (refused before, ranked at a penalty since) is
+        // taken without it.
+        let waived = self.waivers.take(a, b);
+        if !waived && !self.faces_agree_with_input(a, b, world, around, speculation) {
+            self.counters.reject(Rejection::Orientation);
+            self.waivers.waive(a, b);
+            return Attempt::Waived;
+        }
+        // The contraction itself.
+        self.waivers.forget(a);
+        self.waivers.forget(b);
+        self.moved_in_chunk[a as usize] = self.chunk;
+        self.moved_in_chunk[b as usize] = self.chunk;
+        if let Some(exact) = &mut self.exact {
+            // Each collapsed triangle's plane joins `a` and its third corner now.
+            let collapsed = around[0].iter().filter(|x| x.corners.contains(&b));
+            exact.contract(
+                a,
+                b,
+                collapsed.filter_map(|x| {
+                    let third = x.corners.into_iter().find(|&c| c != a && c != b)?;
+                    Some((x.triangle, third))
+                }),
+            );
+        }
+        if let Some(pairs) = &mut self.virtual_pairs {
+            pairs.contract(a, b, |_, _| {});
+        }
+        let (mut slab, fixed) = self.split();
+        let removed = slab.contract(&fixed, [a, b], world, q, around);
+        let is_virtual = shared == 0;
+        if is_virtual {
+            self.counters.virtual_contractions += 1;
+        } else {
+            self.counters.edge_contractions += 1;
+        }
+        self.counters.max_error = self.counters.max_error.max(error);
+        observer.contracted(&Contraction {
+            kept: self.vertex_from[a as usize],
+            removed: self.vertex_from[b as usize],
+            is_virtual,
+            quadric: q,
+            position: placed.position,
+            world: world.to_array(),
+            triangles_removed: removed,
+            cost: placed.cost,
+        });
+        Attempt::Contracted {
+            removed,
+            kept: a,
+            gone: b,
+        }
+    }
+
+    /// Every check of contracting `b` into `a` at `world`, the greedy loop's rules on
+    /// the pass's arrays: fold-over (degenerate, flipped, sliver), merged faces, border
+    /// loops, locks.
+    fn check(
+        &self,
+        a: u32,
+        b: u32,
+        world: DVec3,
+        shared: usize,
+        around: &[Vec<Around>; 2],
+    ) -> Result<(), Rejection> {
+        plain_checks(
+            &self.corners_view(),
+            &self.fixed(),
+            [a, b],
+            world,
+            shared,
+            around,
+        )?;
+        if self.settings.any_locked && self.locked_vertex_would_vanish(a, b, around) {
+            return Err(Rejection::Locked);
+        }
+        Ok(())
+    }
+
+    /// Whether every triangle that contracting `b` into `a` at `world` moves faces the
+    /// same way as the input surface nearest to its new centroid (see
+    /// [`super::orientation`]); true when the check is off. Triangles on both `a` and
+    /// `b` collapse and are not asked.
+    ///
+    /// A face that `speculation` found to agree is taken as agreeing when none of its
+    /// corners has moved since (see [`speculate`](Self::speculate)); the others are
+    /// asked now.
+    fn faces_agree_with_input(
+        &mut self,
+        a: u32,
+        b: u32,
+        world: DVec3,
+        around: &[Vec<Around>; 2],
+        speculation: Option<&Speculation>,
+    ) -> bool {
+        let Some(surface) = self.input_surface.as_mut() else {
+            return true;
+        };
+        let known = speculation.map_or(&[][..], |s| &s.faces[..]);
+        let (chunk, moved_in_chunk) = (self.chunk, &self.moved_in_chunk);
+        let (mut reused, mut asked_again) = (0, 0);
+        let still_holds = |x: &Around| {
+            x.corners
+                .iter()
+                .all(|&c| moved_in_chunk[c as usize] != chunk)
+        };
+        for f in known {
+            if let Some(t) = f.settled {
+                surface.set_hint(f.triangle as usize, t);
+            }
+        }
+        let moved = self.frame.to_normalized(world);
+        // A triangle seen for the first time borrows the hint of the one checked before.
+        let mut neighbour_hint = None;
+        let agrees = around.iter().flatten().all(|x| {
+            let corners = x.corners;
+            if corners.contains(&a) && corners.contains(&b) {
+                return true;
+            }
+            if known.iter().any(|f| f.triangle == x.triangle) {
+                if still_holds(x) {
+                    reused += 1;
+                    return true;
+                }
+                asked_again += 1;
+            }
+            let new = moved_corners(&self.position, corners, [a, b], moved);
+            surface.agrees(x.triangle as usize, new, &mut neighbour_hint)
+        });
+        #[cfg(test)]
+        {
+            self.probes.verdicts_reused += reused;
+            self.probes.verdicts_asked_again += asked_again;
+        }
+        #[cfg(not(test))]
+        let _ = (reused, asked_again);
+        agrees
+    }
+
+    /// Whether contracting `b` into `a` would leave a locked vertex without a triangle:
+    /// `a` itself, or a locked common neighbour whose triangles all collapse or merge.
+    /// A neighbour that moved in this pass may list too few triangles, which can only
+    /// make this refuse.
+    fn locked_vertex_would_vanish(&self, a: u32, b: u32, around: &[Vec<Around>; 2]) -> bool {
+        if self.locked[a as usize] {
+            let left = around[0]
+                .iter()
+                .chain(&around[1])
+                .filter(|x| !(x.corners.contains(&a) && x.corners.contains(&b)))
+                .count();
+            if left == 0 {
+                return true;
+            }
+        }
+        let mut of_w = Vec::new();
+        for x in &around[0] {
+            for w in x.corners {
+                if w == a || w == b || !self.locked[w as usize] {
+                    continue;
+                }
+                if !around[1].iter().any(|y| y.corners.contains(&w)) {
+                    continue; // not a common neighbour
+                }
+                // Merges were refused before this check (`would_merge_faces`), so `w`
+                // keeps every triangle but those on both `a` and `b`.
+                self.gather(w, &mut of_w);
+                if of_w
+                    .iter()
+                    .all(|y| y.corners.contains(&a) && y.corners.contains(&b))
+                {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+}
+
+/// What [`Engine::try_contract`] did.
+pub(super) enum Attempt {
+    /// Contracted `gone` into `kept`, removing `removed` triangles.
+    Contracted {
+        removed: usize,
+        kept: u32,
+        gone: u32,
+    },
+    /// Refused by a check (counted) or to keep the last triangles.
+    Refused,
+    /// Refused by the orientation check (counted), and waived: ranked at a penalty
+    /// next pass, and tried then without the check.
+    Waived,
+    /// The pair's error is above the bound: not contracted.
+    OverErrorBound,
+    /// Not attempted: the ends share no triangle, and virtual pairs were not allowed.
+    NotAPair,
+}
+
+/// The positions of a triangle's `corners` once the pair `ends` is contracted to
+/// `moved` (normalised units): either end goes to `moved`, the others stay.
+pub(super) fn moved_corners(
+    position: &[DVec3],
+    corners: [u32; 3],
+    ends: [u32; 2],
+    moved: DVec3,
+) -> [DVec3; 3] {
+    corners.map(|c| {
+        if ends.contains(&c) {
+            moved
+        } else {
+            position[c as usize]
+        }
+    })
+}

@@ -1,0 +1,784 @@
+//! The one engine: the working mesh (flat arrays), its setup, and what both orders
+//! share (listing and costing pairs, placement, progress, compaction).
+//!
+//! The working mesh: world and normalised positions, quadrics and locks per vertex;
+//! each input triangle's current corners ([`REMOVED`] once it is gone) and input
+//! normal; the live triangles around each vertex ([`Incidence`]); exact quadrics'
+//! planes ([`PassExact`]); the virtual pairs ([`PairSet`]); the orientation check's
+//! index ([`InputSurface`]) and the waivers. A contraction of `b` into `a` renames
+//! `b` to `a` in `b`'s triangles and removes the triangles on both.
+//!
+//! The orders are policies of this engine, each a child module: [`passes`] (the
+//! cheapest independent pairs per pass, meshoptimizer's order) and [`greedy`]
+//! (Garland–Heckbert's heap). Both attempt a pair by [`attempt`]'s one sequence: lock
+//! order, placement, error bound, every check, the orientation check and its waiver,
+//! the contraction, the counters and the observer's event.
+//!
+//! The arrays are numbered in locality order ([`super::locality`]: vertices along a
+//! space-filling curve), so "in order" is also "near in space", whatever order the
+//! input came in; the output and the observer get the cleaned mesh's numbers back.
+
+use super::checks::Rejection;
+use super::counters::Counters;
+use super::incidence::Incidence;
+use super::locality::{in_locality_order, in_original_order, Renumbered};
+use super::nth_key::nth_key;
+use super::observer::{Contraction, Observer, Progress};
+use super::options::QuadricMode;
+use super::options::VirtualPairs;
+use super::options::{BoundaryMode, SimplifyOptions};
+use super::orientation::{InputSurface, Quick};
+use super::pair_set::PairSet;
+use super::pass_blocks::{
+    border_neighbours, contract_block, plain_checks, shared_planes, Around, BlockOutcome,
+    Candidate, Corners, Fixed, Slab, WaiverChange, BLOCK_VERTICES, REMOVED,
+};
+use super::pass_exact::PassExact;
+use super::placement::place_merged;
+use super::report::StopReason;
+use super::settings::Settings;
+use super::waivers::{penalised, Waivers};
+use crate::inspect::{find, union};
+use crate::pairs::grid::{virtual_pairs, GridOptions};
+use crate::store::build::kept_triangles;
+use crate::store::BuildStats;
+use crate::IndexedMesh;
+use qem_core::{unit_normal_and_area, DVec3, Frame, Placement, Quadric, WeightedPlane};
+use rayon::prelude::*;
+use smallvec::SmallVec;
+use std::cmp::Ordering;
+
+/// How often (in attempted contractions) the observer's progress is called.
+const OBSERVER_INTERVAL: usize = 4096;
+
+/// The state of one pass-based run.
+pub(super) struct Engine {
+    pub frame: Frame,
+    pub settings: Settings,
+    pub counters: Counters,
+    /// World positions: a vertex that never moves keeps its input bits.
+    world: Vec<[f64; 3]>,
+    /// The engine's arrays are in locality order ([`super::locality`]): for each
+    /// vertex, its number in the cleaned mesh (for the output and the observer).
+    vertex_from: Vec<u32>,
+    /// For each triangle, its number in the cleaned mesh.
+    triangle_from: Vec<u32>,
+    /// Positions in the normalised frame.
+    position: Vec<DVec3>,
+    quadric: Vec<Quadric>,
+    locked: Vec<bool>,
+    /// Corners of every cleaned input triangle; [`REMOVED`] in the first corner once
+    /// the triangle is gone.
+    triangles: Vec<[u32; 3]>,
+    /// The indices of the live triangles, in increasing order.
+    live: Vec<u32>,
+    /// Each input triangle's (unnormalised) normal in the normalised frame.
+    original_normals: Vec<DVec3>,
+    /// The pass in which each vertex last moved or was removed.
+    moved_in: Vec<u32>,
+    pass: u32,
+    /// The live triangles around each vertex: rebuilt at each pass in the pass-based
+    /// order, merged at each contraction in the greedy order.
+    incidence: Incidence,
+    candidates: Vec<Candidate>,
+    /// Scratch of the batch selection: the batch's candidate indices, the cheapest at
+    /// each vertex, and the selected edges.
+    batch: Vec<u32>,
+    keys: Vec<(f64, u32)>,
+    /// Whether each candidate was attempted in this pass.
+    tried: Vec<bool>,
+    best: Vec<u32>,
+    selected: Vec<u32>,
+    /// Where each vertex's edges (as the smaller end) start in `candidates`, as listed.
+    listed_first: Vec<u32>,
+    /// The last pass's edges and costs in listing order, and where each vertex's start.
+    last_listed: Vec<Candidate>,
+    last_listed_first: Vec<u32>,
+    /// The candidates whose cost this pass ranks at the waivers' penalty, with their
+    /// costs before it (restored before the list becomes `last_listed`).
+    unpenalised_costs: Vec<(u32, f64)>,
+    /// Per vertex, the last vertex whose edges were listed with it (edge listing).
+    seen_with: Vec<u32>,
+    around: [Vec<Around>; 2],
+    /// The number of the current chunk of a round (see [`Engine::speculate`]), and
+    /// per vertex the chunk in which it last moved or was removed.
+    chunk: u32,
+    moved_in_chunk: Vec<u32>,
+    /// The pairs attempted and contracted since the last chunk began (for
+    /// `speculating`).
+    chunk_attempted: usize,
+    chunk_contracted: usize,
+    /// What the tests of speculation and blocks set and read (test builds only).
+    #[cfg(test)]
+    probes: Probes,
+    since_report: usize,
+    /// The input surface for the orientation check; `None` when the check is off.
+    input_surface: Option<InputSurface>,
+    /// Pairs refused by the orientation check, ranked at a penalty and then tried
+    /// without it ([`super::waivers`] says when a waiver ends).
+    waivers: Waivers,
+    /// The planes of exact quadrics; `None` with summed quadrics.
+    exact: Option<PassExact>,
+    /// Vertices per block of [`super::pass_blocks`], and where each block's triangles
+    /// start (the last entry is the triangle count).
+    block_vertices: u32,
+    block_triangles: Vec<u32>,
+    /// Scratch: the pairs of a round the blocks left to the sequential attempts.
+    deferred: Vec<u32>,
+    /// The greedy order's pairs and queue (empty in the pass-based order).
+    greedy: greedy::Greedy,
+    /// The virtual pairs not yet contracted (`None` without them; the greedy order
+    /// takes them into its own pairs).
+    virtual_pairs: Option<PairSet>,
+}
+
+/// A [`Fixed`] borrowing the fields of the engine `$engine`, with the orientation
+/// check's index `$nearest`. A macro rather than a method so that it can borrow those
+/// fields beside mutable borrows of the engine's others (the [`Slab`]).
+macro_rules! fixed_of {
+    ($engine:expr, $nearest:expr) => {
+        Fixed {
+            frame: &$engine.frame,
+            settings: &$engine.settings,
+            incidence: &$engine.incidence,
+            original_normals: &$engine.original_normals,
+            vertex_from: &$engine.vertex_from,
+            pass: $engine.pass,
+            exact: $engine.exact.as_ref(),
+            has_virtual_pairs: $engine.virtual_pairs.is_some(),
+            nearest: $nearest,
+            waivers: &$engine.waivers,
+        }
+    };
+}
+
+/// The whole mesh of the engine `$engine` as one [`Slab`], with the orientation
+/// check's hints `$hints`. A macro for the same reason as [`fixed_of`]: the slab's
+/// mutable borrows sit beside the [`Fixed`]'s shared ones.
+macro_rules! whole_slab_of {
+    ($engine:expr, $hints:expr) => {
+        Slab {
+            first_vertex: 0,
+            first_triangle: 0,
+            position: &mut $engine.position,
+            world: &mut $engine.world,
+            quadric: &mut $engine.quadric,
+            moved_in: &mut $engine.moved_in,
+            triangles: &mut $engine.triangles,
+            hints: $hints,
+        }
+    };
+}
+
+impl Engine {
+    /// Face quadrics summed into vertex quadrics, border planes or locks, locked
+    /// vertices; `locked` lists cleaned-mesh indices.
+    pub fn new(
+        cleaned: &IndexedMesh,
+        frame: Frame,
+        locked: &[u32],
+        options: &SimplifyOptions,
+    ) -> Self {
+        let Renumbered {
+            mesh,
+            vertex_from,
+            vertex_to,
+            triangle_from,
+        } = in_locality_order(cleaned, &frame);
+        let n = mesh.positions.len();
+        let position: Vec<DVec3> = mesh
+            .positions
+            .par_iter()
+            .map(|p| frame.to_normalized(DVec3::from_array(*p)))
+            .collect();
+        // The triangles the store would keep: none with a repeated corner (it would
+        // count as live while having no area), only the first of each vertex set (the
+        // locality order keeps it first). Cleaning has dropped both when its passes
+        // were on; the search (16 bytes a triangle, at the setup's memory peak) runs
+        // only when they were off.
+        let live = if options.clean.drop_repeated_index && options.clean.drop_duplicates {
+            (0..mesh.triangles.len() as u32).collect()
+        } else {
+            kept_triangles(&mesh.triangles, n, &mut BuildStats::default())
+        };
+        let mut engine = Engine {
+            settings: Settings::new(options, &frame),
+            frame,
+            counters: Counters::default(),
+            world: mesh.positions,
+            vertex_from,
+            triangle_from,
+            // Summed by `sum_face_planes` (a filled array made first was 80 bytes a
+            // vertex of pages written twice).
+            quadric: Vec::new(),
+            locked: vec![false; n],
+            triangles: mesh.triangles,
+            live,
+            original_normals: Vec::new(),
+            moved_in: vec![0; n],
+            pass: 0,
+            incidence: Incidence::default(),
+            candidates: Vec::new(),
+            batch: Vec::new(),
+            keys: Vec::new(),
+            tried: Vec::new(),
+            best: vec![u32::MAX; n],
+            selected: Vec::new(),
+            listed_first: Vec::new(),
+            last_listed: Vec::new(),
+            last_listed_first: Vec::new(),
+            unpenalised_costs: Vec::new(),
+            seen_with: vec![u32::MAX; n],
+            around: [Vec::new(), Vec::new()],
+            chunk: 0,
+            moved_in_chunk: vec![0; n],
+            chunk_attempted: 0,
+            chunk_contracted: 0,
+            #[cfg(test)]
+            probes: Probes::default(),
+            since_report: 0,
+            input_surface: None,
+            waivers: Waivers::new(n),
+            exact: (options.quadrics == QuadricMode::Exact).then(|| PassExact::new(n)),
+            position,
+            block_vertices: BLOCK_VERTICES,
+            block_triangles: Vec::new(),
+            deferred: Vec::new(),
+            greedy: greedy::Greedy::default(),
+            virtual_pairs: None,
+        };
+        engine.set_block_vertices(BLOCK_VERTICES);
+        // The incident lists first: the quadrics are summed along them.
+        engine.list_incident_triangles();
+        let area_offset = engine.sum_face_planes(options);
+        engine.initialise_boundary(options, area_offset);
+        for &i in locked {
+            if let Some(&v) = vertex_to.get(i as usize) {
+                engine.locked[v as usize] = true;
+            }
+        }
+        engine.find_virtual_pairs(options);
+        engine.counters.locked_vertices = engine.locked.iter().filter(|&&l| l).count();
+        engine.settings.any_locked = engine.counters.locked_vertices > 0;
+        engine
+    }
+
+    /// Turns the orientation check on with `surface`, built from the same cleaned mesh
+    /// (`slots` as [`InputSurface::new`] returned them): each triangle's first hint is
+    /// its own input triangle.
+    pub fn set_input_surface(&mut self, mut surface: InputSurface, slots: &[u32]) {
+        let hints = (self.triangle_from.iter().enumerate())
+            .map(|(t, &cleaned_t)| (t, slots[cleaned_t as usize]));
+        surface.seed_hints(hints);
+        self.input_surface = Some(surface);
+    }
+
+    /// The virtual pairs: vertices closer than the pair threshold and not joined by
+    /// an edge (only between different parts with [`VirtualPairs::BetweenComponents`]),
+    /// at most the nearest few per vertex (see [`GridOptions`]).
+    fn find_virtual_pairs(&mut self, options: &SimplifyOptions) {
+        let threshold = self.settings.virtual_pair_threshold;
+        if threshold.is_nan() || threshold <= 0.0 {
+            return;
+        }
+        let n = self.position.len();
+        let part = (options.virtual_pairs == VirtualPairs::BetweenComponents).then(|| {
+            let mut parent: Vec<usize> = (0..n).collect();
+            for &t in &self.live {
+                let [x, y, z] = self.triangles[t as usize].map(|c| c as usize);
+                union(&mut parent, x, y);
+                union(&mut parent, x, z);
+            }
+            (0..n)
+                .map(|v| find(&mut parent, v) as u32)
+                .collect::<Vec<u32>>()
+        });
+        let points: Vec<[f64; 3]> = self.position.iter().map(|p| p.to_array()).collect();
+        let grid =
+            GridOptions::new(threshold).with_max_per_vertex(options.max_virtual_pairs_per_vertex);
+        let (incidence, triangles) = (&self.incidence, &self.triangles);
+        let found = virtual_pairs(&points, &grid, |i, j| {
+            let separate = part.as_ref().is_none_or(|p| p[i as usize] != p[j as usize]);
+            let joined = || {
+                let (walked, other) = incidence.shorter(i, j);
+                (incidence.of(walked).iter()).any(|&t| triangles[t as usize].contains(&other))
+            };
+            separate && !joined()
+        });
+        self.counters.virtual_pairs = found.pairs.len();
+        self.counters.virtual_pairs_capped = found.capped;
+        if !found.pairs.is_empty() {
+            let ends = found.pairs.into_iter().map(|(i, j)| [i, j]).collect();
+            self.virtual_pairs = Some(PairSet::new(n, ends));
+        }
+    }
+
+    /// What no contraction of the pass changes, for the shared pieces of an attempt
+    /// ([`super::pass_blocks`]).
+    fn fixed(&self) -> Fixed<'_> {
+        fixed_of!(self, None)
+    }
+
+    /// Every vertex's positions, for the fold-over check.
+    fn corners_view(&self) -> Corners<'_> {
+        Corners {
+            first_vertex: 0,
+            position: &self.position,
+            world: &self.world,
+        }
+    }
+
+    /// The whole mesh as one [`Slab`] (for the sequential attempts), and what does not
+    /// change.
+    fn split(&mut self) -> (Slab<'_>, Fixed<'_>) {
+        let slab = whole_slab_of!(self, &mut []);
+        let fixed = fixed_of!(self, None);
+        (slab, fixed)
+    }
+
+    /// Sets the vertices per block of [`super::pass_blocks`] (tests use small blocks
+    /// on small meshes). Only before the run: the triangles' numbers are by lowest
+    /// corner then, which is what makes each block's triangles one run.
+    pub(super) fn set_block_vertices(&mut self, block_vertices: u32) {
+        debug_assert_eq!(self.pass, 0);
+        self.block_vertices = block_vertices.max(1);
+        let blocks = (self.position.len() as u32).div_ceil(self.block_vertices);
+        let triangles = &self.triangles;
+        self.block_triangles = (0..=blocks)
+            .map(|k| {
+                let start = k.saturating_mul(self.block_vertices);
+                triangles.partition_point(|t| t.iter().min().is_some_and(|&c| c < start)) as u32
+            })
+            .collect();
+    }
+
+    /// The corners of triangle `t` in the normalised frame.
+    fn corners(&self, t: [u32; 3]) -> [DVec3; 3] {
+        t.map(|c| self.position[c as usize])
+    }
+
+    /// Each face's normal and plane, and each vertex's quadric summed along its incident
+    /// list (both on the thread pool; each sum in a fixed order, so the bits do not
+    /// depend on the thread count). Needs the incident lists. Returns the weighting's
+    /// constant added to face areas (`None`: unit weights).
+    fn sum_face_planes(&mut self, options: &SimplifyOptions) -> Option<f64> {
+        // The areas on both cores, summed on one in the order of `live`: the bits of
+        // that order, whatever the thread count.
+        let areas: Vec<f64> = self
+            .live
+            .par_iter()
+            .map(|&t| {
+                let [a, b, c] = self.corners(self.triangles[t as usize]);
+                unit_normal_and_area(a, b, c).map_or(0.0, |(_, area)| area)
+            })
+            .collect();
+        let areas: f64 = areas.iter().sum();
+        let mean_area = if self.live.is_empty() {
+            0.0
+        } else {
+            areas / self.live.len() as f64
+        };
+        let area_offset = options.weighting.area_offset(mean_area);
+        // Each triangle's normal and weighted plane, by triangle index, on both cores;
+        // a triangle that is not live keeps a zero normal (never read) and no plane.
+        // Planes rather than quadrics kept (40 bytes a triangle instead of 80, at the
+        // setup's memory peak); with exact quadrics the planes are kept for the run.
+        // Both arrays are written once, by the threads that compute them: filled
+        // arrays made first were 64 bytes a triangle of pages faulted in and zeroed on
+        // one core (14% of the sphere:4M run's page faults), then written again.
+        let count = self.triangles.len();
+        let is_live = (self.live.len() < count).then(|| {
+            let mut is_live = vec![false; count];
+            for &t in &self.live {
+                is_live[t as usize] = true;
+            }
+            is_live
+        });
+        let (position, triangles) = (&self.position, &self.triangles);
+        let (mut normals, mut planes) = (Vec::new(), Vec::new());
+        (0..count)
+            .into_par_iter()
+            .map(|t| {
+                if is_live.as_ref().is_some_and(|live| !live[t]) {
+                    return (DVec3::ZERO, WeightedPlane::NONE);
+                }
+                let [pa, pb, pc] = triangles[t].map(|c| position[c as usize]);
+                let plane = match area_offset {
+                    Some(extra) => WeightedPlane::from_triangle_area_plus(pa, pb, pc, extra),
+                    None => WeightedPlane::from_triangle_unweighted(pa, pb, pc),
+                };
+                ((pb - pa).cross(pc - pa), plane)
+            })
+            .unzip_into_vecs(&mut normals, &mut planes);
+        // Each vertex's quadric, summed over its live triangles in the order of
+        // `live` (the order of its incident list): the bits the sum in that order gives,
+        // whatever the thread count. (Made from the plane at each corner rather than
+        // kept per triangle: 80 bytes a triangle saved.)
+        let incidence = &self.incidence;
+        self.quadric = (0..self.position.len() as u32)
+            .into_par_iter()
+            .map(|v| {
+                let mut sum = Quadric::default();
+                for &t in incidence.of(v) {
+                    sum += planes[t as usize].quadric();
+                }
+                sum
+            })
+            .collect();
+        self.original_normals = normals;
+        if let Some(exact) = &mut self.exact {
+            exact.set_face_planes(planes);
+        }
+        area_offset
+    }
+}
+
+impl Engine {
+    /// Lists the live triangles around every vertex, each vertex's in increasing
+    /// triangle order (a counting sort of the live triangles' corners).
+    fn list_incident_triangles(&mut self) {
+        let (live, triangles) = (&self.live, &self.triangles);
+        self.incidence.rebuild(self.position.len(), || {
+            live.iter()
+                .flat_map(move |&t| triangles[t as usize].map(move |c| (c, t)))
+        });
+    }
+
+    /// The live triangles around `v`, with their current corners, into `out`.
+    fn gather(&self, v: u32, out: &mut Vec<Around>) {
+        out.clear();
+        for &t in self.incidence.of(v) {
+            let corners = self.triangles[t as usize];
+            if corners[0] != REMOVED {
+                out.push(Around {
+                    triangle: t,
+                    corners,
+                });
+            }
+        }
+    }
+
+    /// Border planes ([`BoundaryMode::Planes`]) or border locks ([`BoundaryMode::Locked`]),
+    /// as the greedy loop adds them: a border edge is an edge of exactly one triangle.
+    ///
+    /// The border edges are found on the thread pool, each vertex's from its smaller
+    /// end by [`border_neighbours`], in the order of the vertex's triangles; then added
+    /// on one core in vertex order, so the sums, and their bits, are the same whatever
+    /// the thread count. (The search on one core, with a table of counts indexed by
+    /// vertex, was 53 of the 178 ms of the dragon's `--fast` setup.)
+    fn initialise_boundary(&mut self, options: &SimplifyOptions, area_offset: Option<f64>) {
+        let weight = match options.boundary {
+            BoundaryMode::Free => return,
+            BoundaryMode::Planes(w) if w > 0.0 && w.is_finite() => Some(w),
+            BoundaryMode::Planes(_) => return,
+            BoundaryMode::Locked => None,
+        };
+        // (smaller end, larger end, the edge's triangle)
+        let borders: Vec<(u32, u32, u32)> = (0..self.position.len() as u32)
+            .into_par_iter()
+            .map_init(Vec::new, |around, v| {
+                self.gather(v, around);
+                let ends = border_neighbours(v, around);
+                let mut found = SmallVec::<[(u32, u32, u32); 4]>::new();
+                if ends.last().is_some_and(|&last| last > v) {
+                    for x in around.iter() {
+                        for c in x.corners {
+                            if c > v && ends.binary_search(&c).is_ok() {
+                                found.push((v, c, x.triangle));
+                            }
+                        }
+                    }
+                }
+                found
+            })
+            .flat_map_iter(|found| found)
+            .collect();
+        for (v, x, t) in borders {
+            let Some(w) = weight else {
+                self.locked[v as usize] = true;
+                self.locked[x as usize] = true;
+                continue;
+            };
+            let [p0, p1, p2] = self.corners(self.triangles[t as usize]);
+            let normal = (p1 - p0).cross(p2 - p0).normalize_or_zero();
+            let (pa, pb) = (self.position[v as usize], self.position[x as usize]);
+            let plane_weight = match area_offset {
+                Some(extra) => w * (pa.distance_squared(pb) + extra),
+                None => w,
+            };
+            let q = Quadric::boundary_constraint(pa, pb, normal, plane_weight);
+            self.quadric[v as usize] += q;
+            self.quadric[x as usize] += q;
+            if let Some(exact) = &mut self.exact {
+                exact.add_border_plane(v, x, q);
+            }
+        }
+    }
+
+    /// Counts `attempted` more attempts and, every [`OBSERVER_INTERVAL`] of them, tells
+    /// the observer the live triangle count (of the run's `start`, towards `target`) and
+    /// asks whether to stop: `true` when it says so.
+    fn count_attempts(
+        &mut self,
+        attempted: usize,
+        [live, start, target]: [usize; 3],
+        observer: &mut dyn Observer,
+    ) -> bool {
+        self.since_report += attempted;
+        if self.since_report < OBSERVER_INTERVAL {
+            return false;
+        }
+        self.since_report = 0;
+        observer.progress(Progress {
+            triangles: live,
+            triangles_start: start,
+            target,
+        });
+        observer.should_stop()
+    }
+
+    /// Lists every edge of the live triangles once, as (smaller end, larger end), in
+    /// order of the smaller end. The last pass's list, with its costs as computed
+    /// (unpenalised), becomes `last_listed`, and the list before it is overwritten.
+    fn list_edges(&mut self) {
+        // Handed over rather than copied at costing time: the copy was 16 bytes an edge
+        // a pass, the first pass's onto fresh pages.
+        for (i, cost) in self.unpenalised_costs.drain(..) {
+            self.candidates[i as usize].cost = cost;
+        }
+        std::mem::swap(&mut self.candidates, &mut self.last_listed);
+        std::mem::swap(&mut self.listed_first, &mut self.last_listed_first);
+        self.seen_with.fill(u32::MAX);
+        self.candidates.clear();
+        self.listed_first.clear();
+        for v in 0..self.position.len() as u32 {
+            self.listed_first.push(self.candidates.len() as u32);
+            for &t in self.incidence.of(v) {
+                for c in self.triangles[t as usize] {
+                    if c > v && self.seen_with[c as usize] != v {
+                        self.seen_with[c as usize] = v;
+                        self.candidates.push(Candidate {
+                            a: v,
+                            b: c,
+                            cost: 0.0,
+                        });
+                    }
+                }
+            }
+            // Then its virtual pairs that are not edges (yet), each once.
+            if let Some(pairs) = &self.virtual_pairs {
+                for &id in pairs.of(v) {
+                    let [x, c] = pairs.ends(id);
+                    if x == v && self.seen_with[c as usize] != v {
+                        self.seen_with[c as usize] = v;
+                        self.candidates.push(Candidate {
+                            a: v,
+                            b: c,
+                            cost: 0.0,
+                        });
+                    }
+                }
+            }
+        }
+        self.listed_first.push(self.candidates.len() as u32);
+    }
+
+    /// Costs every candidate, on both cores (each cost reads only its two ends). A NaN
+    /// cost (only from overflow) is stored as +∞, so that it comes last.
+    ///
+    /// An edge whose ends did not move in the last pass existed then (a new edge
+    /// always has a moved end) and has the same quadrics and positions, so its cost is
+    /// taken from the last pass's list instead of solved again: the same value, bit
+    /// for bit. Late passes re-cost only a few percent of their edges this way.
+    fn cost_edges(&mut self) {
+        // Written in place (the list taken out so the rest of `self` can be read
+        // meanwhile): a fresh list of costs each pass was 8 bytes per edge of new
+        // pages to fault in and then copy over.
+        let mut candidates = std::mem::take(&mut self.candidates);
+        let this = &*self;
+        candidates.par_iter_mut().for_each(|c| {
+            c.cost = match this.last_cost(c.a, c.b) {
+                Some(cost) => cost,
+                None => {
+                    let (placed, _) = this.place(c.a, c.b);
+                    if placed.cost.is_nan() {
+                        f64::INFINITY
+                    } else {
+                        placed.cost
+                    }
+                }
+            };
+        });
+        self.candidates = candidates;
+        // Waived pairs are ranked at the greedy loop's penalty on their merged quadric.
+        // (Few: a pass lists them first, then reads their quadrics.)
+        if self.waivers.is_empty() {
+            return;
+        }
+        let waived: Vec<usize> = (0..self.candidates.len())
+            .filter(|&i| {
+                let c = &self.candidates[i];
+                self.waivers.contains(c.a, c.b)
+            })
+            .collect();
+        // The unpenalised costs are the ones a later pass may reuse: kept aside.
+        for i in waived {
+            let Candidate { a, b, cost } = self.candidates[i];
+            self.unpenalised_costs.push((i as u32, cost));
+            self.candidates[i].cost = penalised(cost, &self.merged_quadric(a, b));
+        }
+    }
+
+    /// The cost of the edge `a b` (`a < b`) in the last pass's list, when neither end
+    /// moved in that pass.
+    fn last_cost(&self, a: u32, b: u32) -> Option<f64> {
+        let last = self.pass.checked_sub(1).filter(|&p| p > 0)?;
+        if self.moved_in[a as usize] == last || self.moved_in[b as usize] == last {
+            return None;
+        }
+        let range = self.last_listed_first[a as usize] as usize
+            ..self.last_listed_first[a as usize + 1] as usize;
+        self.last_listed[range]
+            .iter()
+            .find(|c| c.b == b)
+            .map(|c| c.cost)
+    }
+
+    /// The merged quadric of `a` and `b`, where the new vertex would go and its cost;
+    /// a locked end stays put.
+    fn place(&self, a: u32, b: u32) -> (Placement, Quadric) {
+        let q = self.merged_quadric(a, b);
+        let (a, b) = (a as usize, b as usize);
+        let ends = [
+            (self.position[a], self.locked[a]),
+            (self.position[b], self.locked[b]),
+        ];
+        (place_merged(&q, ends, self.settings.placement), q)
+    }
+
+    /// The quadric of `a` and `b` merged: `Q_a + Q_b`, less `Q_ab` with exact quadrics.
+    fn merged_quadric(&self, a: u32, b: u32) -> Quadric {
+        let mut q = self.quadric[a as usize] + self.quadric[b as usize];
+        if let Some(exact) = &self.exact {
+            q -= self.shared_planes(exact, a, b);
+        }
+        q
+    }
+
+    /// `Q_ab` of exact quadrics for `a` and `b` ([`shared_planes`]).
+    fn shared_planes(&self, exact: &PassExact, a: u32, b: u32) -> Quadric {
+        let triangles = (0, &self.triangles[..]);
+        shared_planes(&self.incidence, triangles, exact, [a, b])
+    }
+
+    /// Takes the removed triangles off the live list, ending the pass.
+    fn drop_removed(&mut self) {
+        let triangles = &self.triangles;
+        self.live.retain(|&t| triangles[t as usize][0] != REMOVED);
+    }
+
+    /// The live triangles and the vertices they use, in model units, numbered and
+    /// ordered as in the cleaned mesh.
+    ///
+    /// Only the used vertices: after a tenfold reduction nine in ten are unused, and
+    /// the caller's cleaning of the output walks every vertex it is given (on one core,
+    /// for most of its steps). What it drops is the same either way: unused vertices
+    /// are dropped without a trace, and the used ones keep their order.
+    pub fn to_mesh(&self) -> IndexedMesh {
+        let mut number = vec![u32::MAX; self.world.len()];
+        for &t in &self.live {
+            for c in self.triangles[t as usize] {
+                number[c as usize] = 0;
+            }
+        }
+        let mut positions = Vec::new();
+        let mut vertex_from = Vec::new();
+        for (v, new) in number.iter_mut().enumerate() {
+            if *new == 0 {
+                *new = positions.len() as u32;
+                positions.push(self.world[v]);
+                vertex_from.push(self.vertex_from[v]);
+            }
+        }
+        let mesh = IndexedMesh {
+            positions,
+            triangles: self
+                .live
+                .iter()
+                .map(|&t| self.triangles[t as usize].map(|c| number[c as usize]))
+                .collect(),
+        };
+        let triangle_from: Vec<u32> = self
+            .live
+            .iter()
+            .map(|&t| self.triangle_from[t as usize])
+            .collect();
+        in_original_order(mesh, self.vertex_from.len(), &vertex_from, &triangle_from)
+    }
+
+    /// Live triangles whose normal points more than 90° away from the input triangle's.
+    pub fn flipped_faces(&self) -> usize {
+        self.live
+            .iter()
+            .filter(|&&t| {
+                let [p0, p1, p2] = self.corners(self.triangles[t as usize]);
+                (p1 - p0)
+                    .cross(p2 - p0)
+                    .dot(self.original_normals[t as usize])
+                    < 0.0
+            })
+            .count()
+    }
+}
+
+/// What the tests of speculation and blocks set and read on a run (test builds only:
+/// release builds have neither the switches nor the counts).
+#[cfg(test)]
+#[derive(Debug)]
+struct Probes {
+    /// Whether chunks may be speculated (the tests compare outputs with and without).
+    speculate_chunks: bool,
+    /// Instead of the blocks, attempt a round's interior pairs and then the others in
+    /// order, all by the sequential attempts (the order the blocks must give the
+    /// result of; see `interior_first`).
+    blocks_in_order: bool,
+    /// Moved faces' orientation verdicts taken from a speculation, and asked again
+    /// because a corner had moved since.
+    verdicts_reused: usize,
+    verdicts_asked_again: usize,
+    /// Pairs the blocks contracted, and left to the sequential attempts.
+    block_contractions: usize,
+    block_deferrals: usize,
+}
+
+#[cfg(test)]
+impl Default for Probes {
+    fn default() -> Self {
+        Probes {
+            speculate_chunks: true,
+            blocks_in_order: false,
+            verdicts_reused: 0,
+            verdicts_asked_again: 0,
+            block_contractions: 0,
+            block_deferrals: 0,
+        }
+    }
+}
+
+use attempt::{moved_corners, Attempt};
+use passes::Speculation;
+
+#[path = "attempt.rs"]
+mod attempt;
+#[path = "greedy.rs"]
+mod greedy;
+#[path = "passes.rs"]
+mod passes;
+
+#[cfg(test)]
+#[path = "passes_speculation_tests.rs"]
+mod speculation_tests;
+
+#[cfg(test)]
+#[path = "passes_blocks_tests.rs"]
+mod blocks_tests;
