@@ -1,7 +1,7 @@
 """Times qem against pyfqmr and fast-simplification on the same NumPy arrays, and
 measures every result against the input with qem.measure (Metro-style distances).
 
-    python crates/qem-py/examples/compare.py MESH [--ratio 0.1] [--runs 3]
+    python crates/qem-py/examples/compare.py MESH [--ratio 0.1] [--runs 3] [--cli QEM]
 
 MESH is any file qem.load reads (.obj .ply .stl .off, optionally .gz). The peers are
 optional imports (pip install pyfqmr fast-simplification); a missing one is listed as
@@ -10,10 +10,18 @@ the timing) and the same target triangle count; the time is the median wall time
 --runs calls of the tool's Python function, and the errors are those of the last run.
 Errors are percentages of the input's bounding-box diagonal: the symmetric Hausdorff
 distance and the mean distance from the input's surface to the output's and back.
+
+With --cli QEM (a `qem` binary, e.g. target/dist/qem), qem's Python call is also timed
+against the command's own simplify phase (`timings_ms.simplify` of its report) on the
+same file and target, the two taking turns run by run: what the binding adds.
 """
 
 import argparse
+import json
+import os
 import platform
+import subprocess
+import tempfile
 import statistics
 import sys
 import time
@@ -60,6 +68,7 @@ def main():
     parser.add_argument("mesh")
     parser.add_argument("--ratio", type=float, default=0.1)
     parser.add_argument("--runs", type=int, default=3)
+    parser.add_argument("--cli", help="a qem binary to time the binding against")
     args = parser.parse_args()
 
     vertices, faces = qem.load(args.mesh)
@@ -98,6 +107,31 @@ def main():
             f"{100 * m['hausdorff']:.4f} | {100 * m['mean_ab']:.5f} | {100 * m['mean_ba']:.5f} |"
         )
         sys.stdout.flush()
+    if args.cli:
+        binding_against_cli(args, vertices, faces, target)
+
+
+def binding_against_cli(args, vertices, faces, target):
+    print()
+    print("| options | qem.simplify (s) | CLI simplify phase (s) | ratio |")
+    print("|---|---:|---:|---:|")
+    with tempfile.TemporaryDirectory() as work:
+        out, report = os.path.join(work, "out.ply"), os.path.join(work, "report.json")
+        for label, flags, options in [("defaults", [], {}), ("fast=True", ["--fast"], {"fast": True})]:
+            py, cli = [], []
+            for _ in range(args.runs):
+                subprocess.run(
+                    [args.cli, "simplify", args.mesh, "-o", out, "--triangles", str(target),
+                     "--report", report, "-q"] + flags,
+                    check=True,
+                )
+                with open(report) as f:
+                    cli.append(json.load(f)["timings_ms"]["simplify"] / 1e3)
+                start = time.perf_counter()
+                qem.simplify(vertices, faces, triangles=target, **options)
+                py.append(time.perf_counter() - start)
+            p, c = statistics.median(py), statistics.median(cli)
+            print(f"| {label} | {p:.3f} | {c:.3f} | {p / c:.3f} |")
 
 
 if __name__ == "__main__":
