@@ -1,11 +1,11 @@
 #!/bin/bash
 # Peak memory and time of `qem simplify` on large hostile files (too slow or too big for
 # the test suite), as recorded in FUZZING.md. Needs python3 and GNU time.
-# Usage: fuzz/measure-hostile.sh [QEM_BINARY]   (default: target/release/qem, built first)
+# Usage: fuzz/measure-hostile.sh [QEM_BINARY]   (default: target/dist/qem, built first)
 set -eu
 cd "$(dirname "$0")/.."
-qem=${1:-target/release/qem}
-if [ $# -eq 0 ]; then cargo build --release -p qem-cli -q; fi
+qem=${1:-target/dist/qem}
+if [ $# -eq 0 ]; then cargo build --profile dist -p qem-cli -q; fi
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 python3 - "$dir" <<'PY'

@@ -53,7 +53,7 @@ both `qem measure --json` and the harness, and writes a comparison table between
 `<!-- measure-agreement:start -->` and `<!-- measure-agreement:end -->`.
 
 Python 3 standard library only; the harness runs in its own venv.
-Build first: `cargo build --release -p qem-cli`.
+Build first: `cargo build --profile dist -p qem-cli`.
 """
 import argparse
 import hashlib
@@ -452,7 +452,7 @@ def main():
     ap.add_argument("--corpus", default=os.environ.get("QEM_CORPUS", os.path.join(ROOT, "..", "shared", "corpus")))
     ap.add_argument("--peers-dir", default=os.path.join(ROOT, "..", "shared", "tools", "peers"))
     ap.add_argument("--peers-python", default=None, help="the harness venv's python")
-    ap.add_argument("--qem", default=os.path.join(ROOT, "target", "release", "qem"))
+    ap.add_argument("--qem", default=os.path.join(ROOT, "target", "dist", "qem"))
     ap.add_argument("--qem-args", default="", help="extra `qem simplify` arguments for the qem row")
     ap.add_argument("--variant", action="append", default=[], help="NAME='extra qem simplify args' (repeatable)")
     ap.add_argument("--meshes", default="", help="comma list of corpus names (default: the clean scans)")
@@ -476,7 +476,7 @@ def main():
     if not os.path.isfile(os.path.join(args.corpus, "manifest.tsv")):
         sys.exit(f"corpus not found at {args.corpus} (set --corpus or QEM_CORPUS)")
     if not os.path.exists(args.qem):
-        sys.exit(f"{args.qem} not found: run `cargo build --release -p qem-cli` first")
+        sys.exit(f"{args.qem} not found: run `cargo build --profile dist -p qem-cli` first")
     rows = read_manifest(args.corpus)
     clean = [mesh_name(r) for r in clean_scans(rows)]
     print(f"clean scans (category scan-*, all of {', '.join(CLEAN_ZERO_COLUMNS)} = 0): {', '.join(clean)}")

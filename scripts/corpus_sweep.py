@@ -2,14 +2,14 @@
 """Run `qem simplify` on every corpus mesh at several ratios and write a table.
 
 usage: scripts/corpus_sweep.py [--corpus DIR] [--ratios 0.5,0.1,0.01] [--out BENCHMARKS.md]
-                               [--qem target/release/qem] [--only NAME,...]
+                               [--qem target/dist/qem] [--only NAME,...]
 
 For each `NAME.obj` in the corpus (default ../shared/corpus, or $QEM_CORPUS) and each
-ratio, runs the release binary with --report, checks the output with the corpus tools'
+ratio, runs the dist binary with --report, checks the output with the corpus tools'
 independent `meshcheck.py` when it is present, and writes a markdown table (mesh, in,
 out, target, time, stop reason, max error, check) between the markers
 `<!-- corpus-sweep:start -->` and `<!-- corpus-sweep:end -->` of the output file.
-Build first: `cargo build --release -p qem-cli`.
+Build first: `cargo build --profile dist -p qem-cli`.
 """
 import argparse, json, os, platform, subprocess, sys, tempfile, time
 
@@ -22,14 +22,14 @@ def main():
     ap.add_argument("--corpus", default=os.environ.get("QEM_CORPUS", os.path.join(ROOT, "..", "shared", "corpus")))
     ap.add_argument("--ratios", default="0.5,0.1,0.01")
     ap.add_argument("--out", default=os.path.join(ROOT, "BENCHMARKS.md"))
-    ap.add_argument("--qem", default=os.path.join(ROOT, "target", "release", "qem"))
+    ap.add_argument("--qem", default=os.path.join(ROOT, "target", "dist", "qem"))
     ap.add_argument("--only", default="")
     ap.add_argument("--extra", default="", help="extra qem simplify arguments, e.g. '--pair-threshold 0.001'")
     a = ap.parse_args()
     if not os.path.isdir(a.corpus):
         sys.exit(f"corpus not found at {a.corpus} (set --corpus or QEM_CORPUS)")
     if not os.path.exists(a.qem):
-        sys.exit(f"{a.qem} not found: run `cargo build --release -p qem-cli` first")
+        sys.exit(f"{a.qem} not found: run `cargo build --profile dist -p qem-cli` first")
     check = os.path.join(a.corpus, "..", "tools", "meshcheck.py")
     names = sorted(f for f in os.listdir(a.corpus) if f.endswith(".obj"))
     if a.only:

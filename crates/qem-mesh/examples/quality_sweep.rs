@@ -4,7 +4,7 @@
 //! rejections by reason and the loop time. Used to choose the defaults of
 //! `SimplifyOptions` (see the commit messages of the quality branch).
 //!
-//! `cargo run --release -p qem-mesh --features io --example quality_sweep -- RATIO FILE...`
+//! `cargo run --profile dist -p qem-mesh --features io --example quality_sweep -- RATIO FILE...`
 
 use qem_mesh::clean::{clean, CleanOptions};
 use qem_mesh::simplify::{simplify, BoundaryMode, QuadricMode, SimplifyOptions, Target};

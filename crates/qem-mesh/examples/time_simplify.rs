@@ -4,7 +4,7 @@
 //! quality controls), `exact` (exact quadrics), `noflip` (no fold-over check), `free`
 //! (free borders).
 //!
-//! `cargo run --release -p qem-mesh --features io --example time_simplify -- FILE RUNS MODE`
+//! `cargo run --profile dist -p qem-mesh --features io --example time_simplify -- FILE RUNS MODE`
 
 use qem_mesh::simplify::{simplify, BoundaryMode, QuadricMode, SimplifyOptions, Target};
 fn main() {
