@@ -10,7 +10,7 @@ mod common;
 use qem_mesh::clean::{clean, CleanOptions};
 use qem_mesh::measure::TriangleBvh;
 use qem_mesh::pairs::{virtual_pairs, GridOptions};
-use qem_mesh::simplify::{simplify, Length, SimplifyOptions, Target};
+use qem_mesh::simplify::{simplify, ContractionOrder, Length, SimplifyOptions, Target};
 use qem_mesh::{IndexedMesh, MeshStore};
 use rayon::ThreadPoolBuilder;
 
@@ -182,19 +182,27 @@ fn the_index_is_the_same_on_1_2_and_3_threads() {
     }
 }
 
+/// In both orders, with virtual pairs and with topology preservation.
 #[test]
 fn simplification_is_the_same_on_1_2_and_3_threads() {
     let soup = messy_soup();
-    let options = SimplifyOptions::DEFAULT
-        .with_target(Target::Ratio(0.05))
-        .with_pair_threshold(Length::DiagonalFraction(0.01));
-    let one = on_threads(1, || simplify(&soup, &options)).expect("simplifies");
-    assert!(one.report.virtual_pairs > 0);
-    for threads in [2, 3] {
-        let many = on_threads(threads, || simplify(&soup, &options)).expect("simplifies");
-        assert_eq!(bits(&many.mesh), bits(&one.mesh), "{threads} threads");
-        let mut report = many.report.clone();
-        report.timings = one.report.timings;
-        assert_eq!(report, one.report, "{threads} threads");
+    for order in [ContractionOrder::Greedy, ContractionOrder::Passes] {
+        for topology in [false, true] {
+            let options = SimplifyOptions::DEFAULT
+                .with_order(order)
+                .with_target(Target::Ratio(0.05))
+                .with_pair_threshold(Length::DiagonalFraction(0.01))
+                .with_preserve_topology(topology);
+            let one = on_threads(1, || simplify(&soup, &options)).expect("simplifies");
+            assert_eq!(one.report.virtual_pairs > 0, !topology, "{order:?}");
+            for threads in [2, 3] {
+                let many = on_threads(threads, || simplify(&soup, &options)).expect("simplifies");
+                let what = format!("{order:?}, topology {topology}, {threads} threads");
+                assert_eq!(bits(&many.mesh), bits(&one.mesh), "{what}");
+                let mut report = many.report.clone();
+                report.timings = one.report.timings;
+                assert_eq!(report, one.report, "{what}");
+            }
+        }
     }
 }

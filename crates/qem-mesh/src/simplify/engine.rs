@@ -647,7 +647,11 @@ impl Engine {
     /// The merged quadric of `a` and `b`, where the new vertex would go and its cost;
     /// a locked end stays put.
     fn place(&self, a: u32, b: u32) -> (Placement, Quadric) {
-        let q = self.merged_quadric(a, b);
+        self.place_with(a, b, self.merged_quadric(a, b))
+    }
+
+    /// [`place`](Self::place) with the merged quadric `q` of `a` and `b` given.
+    fn place_with(&self, a: u32, b: u32, q: Quadric) -> (Placement, Quadric) {
         let (a, b) = (a as usize, b as usize);
         let ends = [
             (self.position[a], self.locked[a]),

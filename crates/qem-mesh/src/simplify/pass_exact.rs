@@ -147,6 +147,18 @@ impl PassExact {
         sum
     }
 
+    /// Each segment at `v` that joins it to another vertex: that vertex and the
+    /// segment's plane.
+    pub fn segments_at(&self, v: u32) -> impl Iterator<Item = (u32, Quadric)> + '_ {
+        self.by_end.of(v).iter().filter_map(move |&i| {
+            let s = self.segments[i as usize];
+            (s.ends != GONE).then(|| {
+                let other = if s.ends[0] == v { s.ends[1] } else { s.ends[0] };
+                (other, self.plane(s.source))
+            })
+        })
+    }
+
     /// The quadric of a segment's plane.
     fn plane(&self, source: u32) -> Quadric {
         let triangles = self.face_planes.len();
