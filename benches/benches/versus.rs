@@ -9,7 +9,8 @@
 //!
 //! - qem: `qem_mesh::simplify::simplify` with `SimplifyOptions::DEFAULT` (t = 0,
 //!   optimal placement, area weighting) and `Target::Triangles(target)`. The timed call
-//!   is the whole library call: validation, cleaning, store, quadrics, loop, compaction.
+//!   is the whole library call: validation, cleaning, the working mesh and its quadrics,
+//!   the loop, compaction.
 //!   With `--fast`, `SimplifyOptions::FAST` instead (the pass-based order, summed
 //!   quadrics, no orientation check), reported as `qem --fast`; `--orientation-check`
 //!   and `--exact` (with `--fast`) turn on the orientation check and exact quadrics.
@@ -366,10 +367,9 @@ fn qem_once(
     let out = out.map_err(|e| format!("qem: {e}"))?;
     let t = out.report.timings;
     eprintln!(
-        "  qem run {run}: clean {:.3} s, build {:.3} s, setup {:.3} s, contract {:.3} s, \
+        "  qem run {run}: clean {:.3} s, setup {:.3} s, contract {:.3} s, \
          compact {:.3} s",
         t.clean.as_secs_f64(),
-        t.build.as_secs_f64(),
         t.setup.as_secs_f64(),
         t.contract.as_secs_f64(),
         t.compact.as_secs_f64()

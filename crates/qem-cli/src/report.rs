@@ -98,7 +98,6 @@ impl SimplifyJson {
             ("simplify", ms(simplify)),
             ("write", ms(write)),
             ("clean", ms(t.clean)),
-            ("build", ms(t.build)),
             ("setup", ms(t.setup)),
             ("contract", ms(t.contract)),
             ("compact", ms(t.compact)),

@@ -695,7 +695,6 @@ fn report_dict<'py>(
     let timings = PyDict::new(py);
     timings.set_item("simplify", ms(simplify))?;
     timings.set_item("clean", ms(t.clean))?;
-    timings.set_item("build", ms(t.build))?;
     timings.set_item("setup", ms(t.setup))?;
     timings.set_item("contract", ms(t.contract))?;
     timings.set_item("compact", ms(t.compact))?;

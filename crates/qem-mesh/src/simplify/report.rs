@@ -41,8 +41,6 @@ impl fmt::Display for StopReason {
 pub struct Timings {
     /// Validation and cleaning.
     pub clean: Duration,
-    /// Building the store (zero in the pass-based order, which has none).
-    pub build: Duration,
     /// Face and vertex quadrics, candidate pairs and the queue (in the pass-based
     /// order: its arrays and the vertex quadrics).
     pub setup: Duration,

@@ -73,7 +73,7 @@ class Report(TypedDict):
     locked_vertices: int
     faces_flipped: int
     timings_ms: dict[str, float]
-    """simplify (the whole library call), clean, build, setup, contract, compact."""
+    """simplify (the whole library call), clean, setup, contract, compact."""
 
 class Measurement(TypedDict):
     """Distances between two meshes as fractions of a's bounding-box diagonal; "ab"
