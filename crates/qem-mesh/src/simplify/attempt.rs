@@ -112,9 +112,8 @@ impl Engine {
             self.counters.reject(why);
             return Attempt::Refused;
         }
-        // Last, as in the greedy loop: the only check that searches outside the
-        // neighbourhood. A waived pair (refused before, ranked at a penalty since) is
-        // taken without it.
+        // Last: the only check that searches outside the neighbourhood. A waived pair
+        // (refused before, ranked at a penalty since) is taken without it.
         let waived = self.waivers.take(a, b);
         if !waived && !self.faces_agree_with_input(a, b, world, around, speculation) {
             self.counters.reject(Rejection::Orientation);
@@ -167,9 +166,9 @@ impl Engine {
         }
     }
 
-    /// Every check of contracting `b` into `a` at `world`, the greedy loop's rules on
-    /// the pass's arrays: fold-over (degenerate, flipped, sliver), merged faces, border
-    /// loops, locks.
+    /// Every check of contracting `b` into `a` at `world` but the orientation check:
+    /// fold-over (degenerate, flipped, sliver), merged faces, border loops, topology,
+    /// locks.
     fn check(
         &self,
         a: u32,

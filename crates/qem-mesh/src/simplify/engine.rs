@@ -191,7 +191,7 @@ impl Engine {
             .par_iter()
             .map(|p| frame.to_normalized(DVec3::from_array(*p)))
             .collect();
-        // The triangles the store would keep: none with a repeated corner (it would
+        // The triangles the engine keeps: none with a repeated corner (it would
         // count as live while having no area), only the first of each vertex set (the
         // locality order keeps it first). Cleaning has dropped both when its passes
         // were on; the search (16 bytes a triangle, at the setup's memory peak) runs
@@ -459,7 +459,7 @@ impl Engine {
     }
 
     /// Border planes ([`BoundaryMode::Planes`]) or border locks ([`BoundaryMode::Locked`]),
-    /// as the greedy loop adds them: a border edge is an edge of exactly one triangle.
+    /// a border edge being an edge of exactly one triangle.
     ///
     /// The border edges are found on the thread pool, each vertex's from its smaller
     /// end by [`border_neighbours`], in the order of the vertex's triangles; then added
@@ -610,7 +610,7 @@ impl Engine {
             };
         });
         self.candidates = candidates;
-        // Waived pairs are ranked at the greedy loop's penalty on their merged quadric.
+        // Waived pairs are ranked at the waivers' penalty on their merged quadric.
         // (Few: a pass lists them first, then reads their quadrics.)
         if self.waivers.is_empty() {
             return;

@@ -1,11 +1,11 @@
-//! The loops' arrays in space-filling-curve order: the cleaned mesh is renumbered
-//! before either contraction order builds its arrays or store, so that vertices and
+//! The engine's arrays in space-filling-curve order: the cleaned mesh is renumbered
+//! before the engine builds its arrays, so that vertices and
 //! triangles near each other in space are near each other in memory, and the output
 //! is numbered back.
 //!
 //! Why: every contraction reads the quadrics, positions, adjacency and neighbouring
 //! triangles of a small patch of the surface, all indexed by vertex and triangle
-//! number (the greedy loop's store by slot, in the order it was built). In the input's
+//! number. In the input's
 //! own order a patch can be spread over the whole of each array, and each read is then
 //! a cache miss. Meshes come in anywhere from well local (marching cubes, grids) to
 //! random (some exporters, merged parts). Measured on the 871k-triangle dragon at
@@ -17,7 +17,7 @@
 //! The order: vertices by the Morton code of their normalised position (21 bits per
 //! axis), ties by their cleaned number; triangles by their lowest renumbered corner,
 //! ties in their cleaned order (so of triangles with the same three vertices the first
-//! stays first, and the store keeps the same one). Both are total orders on the input
+//! stays first, and the engine keeps that one). Both are total orders on the input
 //! alone, so the result does not depend on the threads. Each triangle keeps its corners
 //! in their order.
 //!

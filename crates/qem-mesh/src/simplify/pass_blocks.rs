@@ -512,8 +512,8 @@ pub(super) fn contract_block(
     out
 }
 
-/// The checks every contraction of the pass-based order passes, in the greedy loop's
-/// order: fold-over (degenerate, flipped, sliver), merged faces, border loops. (The
+/// The checks every contraction passes, in both orders and in the block workers:
+/// fold-over (degenerate, flipped, sliver), merged faces, border loops, topology. (The
 /// lock check and the orientation check are the sequential attempts' own.)
 pub(super) fn plain_checks(
     corners: &Corners,

@@ -15,8 +15,8 @@
 //! 4. contracts in rounds: each round takes the batch's *local minima*, the edges
 //!    that are the batch's cheapest at both of their ends (so no two share a vertex),
 //!    in list order (by first vertex, so the arrays are walked in order; the cheapest
-//!    first when the round may reach the target), each checked like the greedy loop's
-//!    pairs (fold-over, merged faces, border loops, locks); then the attempted edges
+//!    first when the round may reach the target), each attempted like the greedy
+//!    order's pairs (`attempt`); then the attempted edges
 //!    and every edge at a moved vertex leave the batch, and the next round starts,
 //!    until the batch is empty or the target is reached. Without locks, and far from
 //!    the target, the pairs of a round whose neighbourhoods lie inside one block of

@@ -125,7 +125,7 @@ impl Waivers {
     }
 }
 
-/// The cost a waived pair is ranked at: the greedy loop's penalty on its cost `cost`
+/// The cost a waived pair is ranked at: [`ORIENTATION_PENALTY`] times its cost `cost`
 /// (at least the floor of [`PENALTY_FLOOR_DISTANCE`] for its merged quadric `q`).
 pub(super) fn penalised(cost: f64, q: &Quadric) -> f64 {
     let floor = q.weight() * PENALTY_FLOOR_DISTANCE * PENALTY_FLOOR_DISTANCE;
