@@ -4,8 +4,8 @@
 use qem_mesh::clean::CleanOptions;
 use qem_mesh::pairs::{virtual_pairs, GridOptions};
 use qem_mesh::simplify::{
-    simplify, simplify_observed, Length, SimplifyError, SimplifyOptions, StopReason, StoreReplay,
-    Target, Weighting,
+    simplify, simplify_observed, ContractionOrder, Length, SimplifyError, SimplifyOptions,
+    StopReason, StoreReplay, Target, Weighting,
 };
 use qem_mesh::IndexedMesh;
 use qem_tests::mesh_checks::assert_valid_output;
@@ -74,6 +74,46 @@ fn zero_area_faces_let_in_are_the_documented_error_not_an_empty_mesh() {
         simplify(&mesh, &options).unwrap_err(),
         SimplifyError::NothingLeftAfterCleaning { triangles_in: 1 }
     );
+}
+
+/// simplify_soup finding of 2026-12-02 (`zero_area_pass_off_face_dropped_at_output_*`),
+/// in the oracle rather than the engine: with the zero-area cleaning pass off, a face
+/// with two coincident (unwelded) corners enters the loop, and the output drops it
+/// after the loop (finding 2 above, counted in `degenerate_faces_removed`). The store
+/// replaying the run kept it, so `StoreReplay::check_output` reported "the store holds
+/// 2 faces and the output 1 triangles" for a correct run, in both orders (all 435
+/// crashes of the first fuzz run of the unified engine were this). The comparison now
+/// leaves out the store's faces that the engine counts as zero-area, at most as many
+/// as the cleaned mesh had.
+#[test]
+fn a_zero_area_face_let_in_and_dropped_at_output_is_not_a_replay_failure() {
+    let mesh = IndexedMesh::new(
+        vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [3.0, 0.0, 0.0],
+            [3.0, 0.0, 0.0],
+            [4.0, 1.0, 0.0],
+        ],
+        vec![[0, 1, 2], [3, 4, 5]],
+    );
+    let clean = CleanOptions::DEFAULT
+        .with_weld_exact(false)
+        .with_drop_zero_area(false);
+    for order in [ContractionOrder::Greedy, ContractionOrder::Passes] {
+        // Two triangles and a target of two: no contraction, only the output's drop.
+        let options = SimplifyOptions::DEFAULT
+            .with_order(order)
+            .with_target(Target::Triangles(2))
+            .with_clean(clean);
+        let mut replay = StoreReplay::default();
+        let out = simplify_observed(&mesh, &options, &mut replay).expect("a valid input");
+        assert_eq!(out.mesh.triangles, vec![[0, 1, 2]], "{order:?}");
+        assert_eq!(out.report.degenerate_faces_removed, 1, "{order:?}");
+        assert_eq!(replay.contractions(), 0, "{order:?}");
+        replay.check_output(&out.mesh).expect("the store agrees");
+    }
 }
 
 /// grid_pairs finding (`saturated_cell_visited_twice`): cell coordinates of points
