@@ -699,7 +699,7 @@ fn build_in_pieces(
 }
 
 /// Ranges at least this long are split on both cores (below it, handing work to rayon
-/// costs more than it saves). `tests/threads.rs` builds an index above this size to
+/// costs more than it saves). `tests/suite/threads.rs` builds an index above this size to
 /// cover the parallel path; raise both together.
 const PARALLEL_PARTITION: usize = 1 << 14;
 

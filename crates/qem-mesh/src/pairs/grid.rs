@@ -168,7 +168,7 @@ mod tests {
     use super::*;
 
     // The comparison with a brute-force reference, over random points, is in the
-    // workspace tests crate (`tests/tests/grid_pairs.rs`), shared with the fuzz target.
+    // workspace tests crate (`tests/tests/suite/grid_pairs.rs`), shared with the fuzz target.
 
     #[test]
     fn no_threshold_no_pairs() {

@@ -15,7 +15,7 @@
 //! cancel when a quadric is evaluated at `p`; the cost itself can be ~0 on flat parts,
 //! where no relative test on the cost alone is meaningful).
 
-mod common;
+use crate::common;
 
 use common::{concat, grid};
 use proptest::prelude::*;

@@ -1,7 +1,7 @@
 //! `qem info`: exact counts on the shipped mesh, and on every corpus mesh the same
 //! counts as the corpus manifest's columns with the same definitions.
 
-mod common;
+use crate::common;
 
 use common::{corpus_dir, qem, s, spot, stderr};
 use qem_mesh::io::write_path;

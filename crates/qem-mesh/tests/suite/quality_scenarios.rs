@@ -1,7 +1,7 @@
 //! Named scenarios of the quality controls: fold-over and sliver checks, border planes
 //! and border locks, locked vertices.
 
-mod common;
+use crate::common;
 
 use common::{
     area, assert_valid, concat, grid, holed_grid, jagged_sheet, qualities, topology, uv_sphere,

@@ -6,7 +6,7 @@
 
 #![cfg(feature = "io")]
 
-mod common;
+use crate::common;
 
 use common::{assert_valid, corpus_dir, corpus_mesh};
 use qem_mesh::measure::closest_point_on_triangle;

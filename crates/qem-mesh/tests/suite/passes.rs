@@ -6,8 +6,8 @@
 //! components) are computed from the triangles alone (`passes_common`), without the
 //! store, so they check the pass engine against an independent count.
 
-mod common;
-mod passes_common;
+use crate::common;
+use crate::passes_common;
 
 use common::{
     assert_valid, concat, grid, jagged_sheet, simplify_replayed, topology, torus, uv_sphere,

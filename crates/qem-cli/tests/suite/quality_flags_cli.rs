@@ -1,7 +1,7 @@
 //! The quality-control flags of `qem simplify` (shared with `qem batch`): locks,
 //! borders, topology, quadrics, and how they show in the report.
 
-mod common;
+use crate::common;
 
 use common::{qem, s, spot, stderr};
 use qem_mesh::inspect::inspect;

@@ -1,6 +1,6 @@
 //! Named scenarios of the contraction engine with exact expectations.
 
-mod common;
+use crate::common;
 
 use common::{assert_valid, concat, grid, uv_sphere};
 use qem_mesh::clean::CleanOptions;

@@ -1,7 +1,7 @@
 //! `qem simplify --lods`: one run, one file per level, nested counts, a report with
 //! every level.
 
-mod common;
+use crate::common;
 
 use common::{json, qem, s, spot, stderr};
 use qem_mesh::io::read_path;

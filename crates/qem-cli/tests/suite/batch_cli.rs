@@ -1,7 +1,7 @@
 //! `qem batch` run as a user would: bad files do not stop good ones, outputs keep their
 //! relative paths, `-j` does not change a byte, colliding outputs are refused.
 
-mod common;
+use crate::common;
 
 use common::{bumpy_grid, json, qem, s, spot, stderr};
 use qem_mesh::io::{read_path, write_path};

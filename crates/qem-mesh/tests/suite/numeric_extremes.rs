@@ -2,7 +2,7 @@
 //! range, inputs that collapse to a point, a single triangle, and very many copies of
 //! one face. Each gives a valid output or the documented error, never a panic.
 
-mod common;
+use crate::common;
 
 use common::{assert_valid, concat, grid, simplify_replayed, uv_sphere};
 use qem_mesh::simplify::{

@@ -5,7 +5,7 @@
 //!
 //! The inputs are large enough (tens of thousands of triangles) for rayon to split the
 //! work: its parallel sorts and maps only divide slices above a few thousand items.
-mod common;
+use crate::common;
 
 use qem_mesh::clean::{clean, CleanOptions};
 use qem_mesh::measure::TriangleBvh;

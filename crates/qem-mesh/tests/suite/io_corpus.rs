@@ -5,7 +5,7 @@
 #![cfg(feature = "io")]
 #![allow(clippy::unwrap_used)]
 
-mod common;
+use crate::common;
 
 use common::corpus_dir;
 use std::collections::HashMap;

@@ -2,7 +2,7 @@
 //! number of border loops of the cleaned input survive simplification, on closed and
 //! open procedural meshes and on corpus meshes (skipped without the corpus).
 
-mod common;
+use crate::common;
 
 use common::{assert_valid, concat, grid, holed_grid, topology, torus, uv_sphere};
 use qem_mesh::clean::{clean, CleanOptions};

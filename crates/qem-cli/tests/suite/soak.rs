@@ -8,7 +8,7 @@
 //! large run is `#[ignore]`d and sized by the environment (FUZZING.md records it):
 //!
 //! ```sh
-//! QEM_SOAK_FILES=500 QEM_SOAK_KILLS=10 cargo test -p qem-cli --test soak -- --ignored --nocapture
+//! QEM_SOAK_FILES=500 QEM_SOAK_KILLS=10 cargo test -p qem-cli --test suite -- --ignored --nocapture soak::
 //! ```
 //!
 //! It derives its files from the shared corpus (`$QEM_CORPUS` or `../shared/corpus`,
@@ -16,7 +16,7 @@
 //! message when the corpus is absent. `QEM_SOAK_SEED` changes the kill moments and
 //! which files are corrupted.
 
-mod common;
+use crate::common;
 
 use common::{bumpy_grid, corpus_dir, json, s};
 use qem_mesh::io::{read_path, write_path};

@@ -13,8 +13,7 @@
 //! has 157,410 edges, so in the first passes each thread of a larger pool costs tens of
 //! thousands of them: the split is real, not a formality of a tiny input.
 
-mod common;
-mod passes_common;
+use crate::passes_common;
 
 use passes_common::bits;
 use qem_mesh::simplify::{simplify, ContractionOrder, SimplifyOptions, StopReason, Target};

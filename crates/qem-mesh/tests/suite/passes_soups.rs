@@ -3,8 +3,8 @@
 //! duplicate faces are common, as in `simplify_soups.rs`) and random bumpy grids with
 //! triangles missing (holes, non-manifold vertices, several parts), at random targets.
 
-mod common;
-mod passes_common;
+use crate::common;
+use crate::passes_common;
 
 use common::assert_valid;
 use passes_common::{bits, border_loops, zero_area_faces_in_input_frame};

@@ -2,7 +2,7 @@
 //! `s = 0` and unit weighting at `s = ∞`, bit for bit, with and without border planes
 //! and exact quadrics, and something else in between.
 
-mod common;
+use crate::common;
 
 use common::{assert_valid, holed_grid, uv_sphere};
 use qem_mesh::simplify::{simplify, QuadricMode, SimplifyOptions, Target, Weighting};

@@ -1,6 +1,6 @@
 //! Runs the built `qem` binary as a user would.
 
-mod common;
+use crate::common;
 
 use common::{qem, spot, stderr};
 use std::process::Command;

@@ -1,7 +1,7 @@
 //! End-to-end properties over random messy soups: coordinates on a small integer grid,
 //! so coincident vertices, zero-area and duplicate faces are common.
 
-mod common;
+use crate::common;
 
 use common::{assert_valid, simplify_replayed};
 use proptest::prelude::*;

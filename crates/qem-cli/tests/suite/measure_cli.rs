@@ -1,6 +1,6 @@
 //! Runs the built `qem measure` as a user would.
 
-mod common;
+use crate::common;
 
 use common::{qem, spot, stderr, stdout};
 use std::path::Path;
