@@ -254,6 +254,19 @@ mod tests {
         }
     }
 
+    /// When the push counter runs out, the live entries are restamped in their order:
+    /// ties still pop oldest first.
+    #[test]
+    fn stamps_running_out_keep_the_order() {
+        let mut queue = PairQueue::new(4);
+        queue.next_stamp = u32::MAX - 2;
+        for id in [2, 0, 3, 1] {
+            queue.push(id, 1.0);
+        }
+        let order: Vec<u32> = std::iter::from_fn(|| queue.pop().map(|(id, _)| id)).collect();
+        assert_eq!(order, vec![2, 0, 3, 1]);
+    }
+
     /// Through pushes, re-costs and removals, pops come out as a sorted model says:
     /// by cost, then oldest push first.
     #[test]
