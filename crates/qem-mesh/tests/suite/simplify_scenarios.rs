@@ -5,8 +5,8 @@ use crate::common;
 use common::{assert_valid, concat, grid, uv_sphere};
 use qem_mesh::clean::CleanOptions;
 use qem_mesh::simplify::{
-    simplify, simplify_levels, simplify_observed, ContractionOrder, Length, NoObserver,
-    SimplifyError, SimplifyOptions, StopReason, StoreReplay, Target,
+    simplify, simplify_levels, Length, NoObserver, SimplifyError, SimplifyOptions, StopReason,
+    Target,
 };
 use qem_mesh::store::{EdgeClass, MeshStore};
 use qem_mesh::IndexedMesh;
@@ -326,6 +326,7 @@ fn a_no_op_with_a_skipped_duplicate_face_keeps_the_input_order() {
 #[cfg(feature = "io")]
 #[test]
 fn the_store_replays_every_contraction_on_small_corpus_meshes() {
+    use qem_mesh::simplify::{simplify_observed, ContractionOrder, StoreReplay};
     let Some(dir) = common::corpus_dir() else {
         return;
     };
