@@ -94,6 +94,13 @@ pub struct SimplifyFlags {
     /// border loops are kept [default: off].
     #[arg(long)]
     pub preserve_topology: bool,
+    /// Stop when no pair passes every check instead of relaxing them: without it, a
+    /// run that gets stuck relaxes the fold-over rules, then the border-loop rule, then
+    /// lets edge contractions merge faces, each only when the stricter rules have
+    /// nothing left (the report's `relaxations`); what you asked for (--preserve-topology,
+    /// --lock, --lock-boundary, --max-error) is never relaxed [default: off].
+    #[arg(long)]
+    pub strict: bool,
     /// Contract in passes over flat arrays instead of one pair at a time: several
     /// times faster, a little less accurate. Uses summed quadrics (unless --quadrics
     /// exact), no orientation check (unless --orientation-check), and the 3x3 solve's
@@ -255,6 +262,7 @@ impl SimplifyFlags {
             .with_min_triangle_quality(self.min_quality)
             .with_orientation_check(orientation_check)
             .with_preserve_topology(self.preserve_topology)
+            .with_strict(self.strict)
             .with_weighting(self.weighting)
             .with_quadrics(match self.quadrics {
                 Some(QuadricsFlag::Sum) => QuadricMode::Sum,

@@ -34,8 +34,15 @@ pub struct SimplifyJson {
     cleanup: BTreeMap<&'static str, usize>,
     degenerate_faces_removed: usize,
     /// Contractions refused, by reason: `degenerate`, `flip`, `sliver`, `topology`,
-    /// `locked`, `border`, `merge`.
+    /// `locked`, `border`, `merge`, `orientation`, `last_triangles`.
     rejected: BTreeMap<&'static str, usize>,
+    /// The steps of the ladder of relaxations the run climbed (none unless it got
+    /// stuck), in order, each with the contractions made under it.
+    relaxations: Vec<RelaxationJson>,
+    /// With `stop_reason` `no_valid_pair`: what stopped the run (`strict`,
+    /// `preserve_topology`, `locks`, `locked_boundary`, `zero_area`, `last_triangles`,
+    /// `no_pairs`); null otherwise.
+    stopped_by: Option<&'static str>,
     /// Vertices locked (by --lock or --lock-boundary).
     locked_vertices: usize,
     /// Output faces whose normal points away from their input face (0 unless the
@@ -45,6 +52,13 @@ pub struct SimplifyJson {
     /// `non_utf8_lines`, `byte_order_mark`.
     read_notes: ReadNotesJson,
     timings_ms: BTreeMap<&'static str, f64>,
+}
+
+/// A step of the ladder of relaxations the run climbed.
+#[derive(Serialize, Debug, Clone, Copy)]
+pub struct RelaxationJson {
+    step: &'static str,
+    contractions: usize,
 }
 
 /// [`ReadNotes`] as JSON.
@@ -129,7 +143,17 @@ impl SimplifyJson {
                 ("border", r.rejected.border),
                 ("merge", r.rejected.merge),
                 ("orientation", r.rejected.orientation),
+                ("last_triangles", r.rejected.last_triangles),
             ]),
+            relaxations: r
+                .relaxations
+                .iter()
+                .map(|x| RelaxationJson {
+                    step: x.step.as_str(),
+                    contractions: x.contractions,
+                })
+                .collect(),
+            stopped_by: r.stopped_by.map(|c| c.as_str()),
             locked_vertices: r.locked_vertices,
             faces_flipped: r.faces_flipped,
             read_notes: notes.into(),
@@ -151,15 +175,32 @@ impl SimplifyJson {
 
     /// One line for the terminal: `in → out: 5856 → 585 triangles, max error 0.4019%
     /// of the bounding-box diagonal (target_reached)`.
+    ///
+    /// A run that got stuck adds the relaxations it climbed (`; relaxed: fold_over 12,
+    /// merged_faces 3`), and one that stopped short with no pair left what stopped it
+    /// (`(no_valid_pair: last_triangles)`).
     pub fn summary_line(&self) -> String {
+        let stop = match self.stopped_by {
+            Some(by) => format!("{}: {by}", self.stop_reason),
+            None => self.stop_reason.to_string(),
+        };
+        let relaxed = if self.relaxations.is_empty() {
+            String::new()
+        } else {
+            let steps: Vec<String> = self
+                .relaxations
+                .iter()
+                .map(|r| format!("{} {}", r.step, r.contractions))
+                .collect();
+            format!("; relaxed: {}", steps.join(", "))
+        };
         format!(
-            "{} → {}: {} → {} triangles, max error {:.4}% of the bounding-box diagonal ({})",
+            "{} → {}: {} → {} triangles, max error {:.4}% of the bounding-box diagonal ({stop}){relaxed}",
             self.input,
             self.output,
             self.triangles_in,
             self.triangles_out,
             self.max_error * 100.0,
-            self.stop_reason
         )
     }
 }

@@ -20,7 +20,7 @@ use numpy::{Element, PyArray2, PyUntypedArray};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyBool, PyDict, PyString};
+use pyo3::types::{PyBool, PyDict, PyList, PyString};
 use qem_mesh::clean::CleanOptions;
 use qem_mesh::measure::{MeasureOptions, Measurement};
 use qem_mesh::simplify::{
@@ -361,6 +361,7 @@ const OPTION_NAMES: &[&str] = &[
     "locked_vertices",
     "clean",
     "order",
+    "strict",
 ];
 
 /// The keys of the `clean` option, the fields of [`CleanOptions`].
@@ -529,6 +530,7 @@ fn simplify_options(options: Option<&Bound<'_, PyDict>>) -> PyResult<SimplifyOpt
             }
             "orientation_check" => o.with_orientation_check(boolean("orientation_check", v)?),
             "preserve_topology" => o.with_preserve_topology(boolean("preserve_topology", v)?),
+            "strict" => o.with_strict(boolean("strict", v)?),
             "locked_vertices" => o.with_locked_vertices(locked_vertices(v)?),
             "clean" => o.with_clean(clean_options(v)?),
             "order" => o.with_order(match choice("order", v, &["greedy", "passes"])? {
@@ -622,6 +624,7 @@ fn options_dict<'py>(py: Python<'py>, o: &SimplifyOptions) -> PyResult<Bound<'py
     d.set_item("min_triangle_quality", o.min_triangle_quality)?;
     d.set_item("orientation_check", o.orientation_check)?;
     d.set_item("preserve_topology", o.preserve_topology)?;
+    d.set_item("strict", o.strict)?;
     d.set_item("locked_vertices", o.locked_vertices.clone())?;
     let c = &o.clean;
     let clean = PyDict::new(py);
@@ -688,7 +691,17 @@ fn report_dict<'py>(
     rejected.set_item("border", r.rejected.border)?;
     rejected.set_item("merge", r.rejected.merge)?;
     rejected.set_item("orientation", r.rejected.orientation)?;
+    rejected.set_item("last_triangles", r.rejected.last_triangles)?;
     d.set_item("rejected", rejected)?;
+    let relaxations = PyList::empty(py);
+    for x in &r.relaxations {
+        let step = PyDict::new(py);
+        step.set_item("step", x.step.as_str())?;
+        step.set_item("contractions", x.contractions)?;
+        relaxations.append(step)?;
+    }
+    d.set_item("relaxations", relaxations)?;
+    d.set_item("stopped_by", r.stopped_by.map(|c| c.as_str()))?;
     d.set_item("locked_vertices", r.locked_vertices)?;
     d.set_item("faces_flipped", r.faces_flipped)?;
     let t = &r.timings;
@@ -784,7 +797,7 @@ impl Observer for PyObserver {
 /// (start from SimplifyOptions::FAST), max_error, absolute, pair_threshold,
 /// max_virtual_pairs_per_vertex, virtual_pairs, placement, weighting, quadrics,
 /// boundary, max_normal_angle, min_triangle_quality, orientation_check,
-/// preserve_topology, locked_vertices, clean, order. The
+/// preserve_topology, locked_vertices, clean, order, strict. The
 /// stub file (qem/__init__.pyi) documents each.
 ///
 /// progress: called as progress(fraction) every few thousand contractions, fraction in

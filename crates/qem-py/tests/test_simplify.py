@@ -29,7 +29,7 @@ def test_returns_valid_arrays_and_a_report(sphere):
     )
     assert set(report["rejected"]) == {
         "degenerate", "flip", "sliver", "topology", "locked", "border", "merge",
-        "orientation",
+        "orientation", "last_triangles",
     }
     assert report["timings_ms"]["simplify"] >= report["timings_ms"]["contract"] >= 0
 
@@ -188,6 +188,33 @@ def test_preserve_topology_in_both_orders(sphere, order):
     edges = {tuple(sorted(e)) for t in f.tolist() for e in ((t[0], t[1]), (t[1], t[2]), (t[0], t[2]))}
     assert len(v) - len(edges) + len(f) == 2
     assert report["virtual_contractions"] == 0
+
+
+def tetrahedra(n):
+    """n separate closed tetrahedra: stuck without the ladder of relaxations."""
+    corners = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=np.float64)
+    vertices = np.concatenate([corners * (1 + 0.01 * i) + [3.0 * i, 0, 0] for i in range(n)])
+    one = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    faces = np.concatenate([one + 4 * i for i in range(n)])
+    return vertices, faces
+
+
+@pytest.mark.parametrize("order", ["greedy", "passes"])
+def test_stuck_runs_climb_the_ladder_unless_strict(order):
+    vertices, faces = tetrahedra(20)
+    v, f, report = qem.simplify(vertices, faces, ratio=0.1, order=order)
+    assert_valid(v, f)
+    assert report["stop_reason"] == "target_reached"
+    assert len(f) == 8
+    assert report["stopped_by"] is None
+    steps = [r["step"] for r in report["relaxations"]]
+    assert steps == ["fold_over", "border_loops", "merged_faces"]
+    assert report["relaxations"][-1]["contractions"] == 18
+    v, f, report = qem.simplify(vertices, faces, ratio=0.1, order=order, strict=True)
+    assert len(f) == 80
+    assert report["stop_reason"] == "no_valid_pair"
+    assert report["stopped_by"] == "strict"
+    assert report["relaxations"] == []
 
 
 def test_clean_options(sphere):

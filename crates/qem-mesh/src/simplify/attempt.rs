@@ -28,7 +28,10 @@ impl Engine {
         self.gather(a, &mut around[0]);
         self.gather(b, &mut around[1]);
         let shared = around[0].iter().filter(|x| x.corners.contains(&b)).count();
-        if shared == 0 && !virtual_allowed {
+        // An end without a live triangle (its last ones went in a merge earlier in the
+        // round) is no pair: merging it would move the other end for nothing.
+        let bare = around[0].is_empty() || around[1].is_empty();
+        if bare || (shared == 0 && !virtual_allowed) {
             self.around = around;
             return Attempt::NotAPair;
         }
@@ -44,13 +47,47 @@ impl Engine {
             (b, a)
         };
         // Never contract the last faces away: the output must keep a triangle.
-        let attempt = if shared >= live {
+        let merged = self.merged_away(a, b, &around, live - shared.min(live));
+        let attempt = if shared + merged.len() >= live {
+            self.counters.reject(Rejection::LastTriangles);
             Attempt::Refused
         } else {
-            self.check_and_contract(a, b, shared, &around, speculation, observer)
+            let star = Star {
+                around: &around,
+                shared,
+                merged: &merged,
+            };
+            self.check_and_contract(a, b, star, speculation, observer)
         };
         self.around = around;
         attempt
+    }
+
+    /// The faces that contracting `b` into `a` removes besides the triangles on both,
+    /// where the ladder allows merges (none otherwise): each pair of faces `b x y` and
+    /// `a x y` that would lie on the same three vertices goes, both of them; but when
+    /// that would leave none of the `left` triangles that the collapse leaves, the face
+    /// `a x y` of each pair stays (a closed part's last faces: a tetrahedron goes down
+    /// to one triangle, not to none).
+    pub(super) fn merged_away(
+        &self,
+        a: u32,
+        b: u32,
+        around: &[Vec<Around>; 2],
+        left: usize,
+    ) -> SmallVec<[u32; 4]> {
+        if !self.settings.allow_merges {
+            return SmallVec::new();
+        }
+        let pairs = merging_faces(a, b, around);
+        if 2 * pairs.len() < left {
+            pairs
+                .iter()
+                .flat_map(|&(from_b, from_a)| [from_b, from_a])
+                .collect()
+        } else {
+            pairs.iter().map(|&(from_b, _)| from_b).collect()
+        }
     }
 
     /// The pair `a b` in the order it is contracted (the second end into the first):
@@ -78,17 +115,21 @@ impl Engine {
         }
     }
 
-    /// [`try_contract`](Self::try_contract) with `around` = the live triangles of `a`
-    /// and of `b`, `shared` of which are on both.
+    /// [`try_contract`](Self::try_contract) with `star`, the triangles around `a` and
+    /// `b`.
     fn check_and_contract(
         &mut self,
         a: u32,
         b: u32,
-        shared: usize,
-        around: &[Vec<Around>; 2],
+        star: Star<'_>,
         speculation: Option<&Speculation>,
         observer: &mut dyn Observer,
     ) -> Attempt {
+        let Star {
+            around,
+            shared,
+            merged,
+        } = star;
         let any_locked = self.locked[a as usize] || self.locked[b as usize];
         let (placed, q) = match speculation {
             Some(s) => {
@@ -108,7 +149,7 @@ impl Engine {
             return Attempt::OverErrorBound;
         }
         let world = self.world_position(a, &placed, any_locked);
-        if let Err(why) = self.check(a, b, world, shared, around) {
+        if let Err(why) = self.check(a, b, world, shared, around, merged) {
             self.counters.reject(why);
             return Attempt::Refused;
         }
@@ -141,7 +182,7 @@ impl Engine {
             pairs.contract(a, b, |_, _| {});
         }
         let (mut slab, fixed) = self.split();
-        let removed = slab.contract(&fixed, [a, b], world, q, around);
+        let removed = slab.contract(&fixed, [a, b], world, q, around, merged);
         let is_virtual = shared == 0;
         if is_virtual {
             self.counters.virtual_contractions += 1;
@@ -176,6 +217,7 @@ impl Engine {
         world: DVec3,
         shared: usize,
         around: &[Vec<Around>; 2],
+        merged: &[u32],
     ) -> Result<(), Rejection> {
         plain_checks(
             &self.corners_view(),
@@ -187,6 +229,19 @@ impl Engine {
         )?;
         if self.settings.any_locked && self.locked_vertex_would_vanish(a, b, around) {
             return Err(Rejection::Locked);
+        }
+        // A merge removes faces at its other corners: never at a locked one, whose
+        // faces `locked_vertex_would_vanish` counts as kept.
+        if self.settings.any_locked {
+            // (The kept end too: the merge may take its last faces.)
+            let touches_lock = merged.iter().any(|&t| {
+                self.triangles[t as usize]
+                    .iter()
+                    .any(|&c| c != b && self.locked[c as usize])
+            });
+            if touches_lock {
+                return Err(Rejection::Locked);
+            }
         }
         Ok(())
     }
@@ -288,6 +343,16 @@ impl Engine {
         }
         false
     }
+}
+
+/// The triangles around a pair `a b` that its attempt reads: the live triangles of
+/// `a` and of `b`, how many are on both, and the faces the contraction merges away
+/// ([`Engine::merged_away`]).
+#[derive(Clone, Copy)]
+pub(super) struct Star<'a> {
+    around: &'a [Vec<Around>; 2],
+    shared: usize,
+    merged: &'a [u32],
 }
 
 /// What [`Engine::try_contract`] did.

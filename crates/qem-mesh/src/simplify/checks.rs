@@ -24,6 +24,8 @@ pub(super) enum Rejection {
     Merge,
     /// A moved face would face away from the input surface nearest to it.
     Orientation,
+    /// The contraction would remove the last triangles.
+    LastTriangles,
 }
 
 /// `4√3·area / (l₀² + l₁² + l₂²)` from twice the area (`double_area`): 1 for an
@@ -91,13 +93,14 @@ pub(super) fn moved_face_verdict(
     }
     let old_normal = (old[1] - old[0]).cross(old[2] - old[0]);
     if let Some(min_cos) = settings.min_normal_cos {
-        // The second test stops a face from turning away from the input face it
-        // descends from in several small steps.
-        if turned_past(old_normal, new_normal, new_squared, min_cos)
-            || input_normal().dot(new_normal) < 0.0
-        {
+        if turned_past(old_normal, new_normal, new_squared, min_cos) {
             return Err(Rejection::Flip);
         }
+    }
+    // Stops a face from turning away from the input face it descends from in several
+    // small steps.
+    if settings.face_input && input_normal().dot(new_normal) < 0.0 {
+        return Err(Rejection::Flip);
     }
     if let Some(min_quality) = settings.min_quality {
         let q_new = quality(new[0], new[1], new[2], new_squared.sqrt());

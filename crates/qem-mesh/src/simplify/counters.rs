@@ -30,6 +30,11 @@ impl Counters {
         self.rejected.add(&other.rejected);
     }
 
+    /// Contractions so far, of edges and of virtual pairs.
+    pub(super) fn contractions(&self) -> usize {
+        self.edge_contractions + self.virtual_contractions
+    }
+
     /// Counts one refusal for `why`.
     pub(super) fn reject(&mut self, why: Rejection) {
         let counter = match why {
@@ -41,6 +46,7 @@ impl Counters {
             Rejection::Border => &mut self.rejected.border,
             Rejection::Merge => &mut self.rejected.merge,
             Rejection::Orientation => &mut self.rejected.orientation,
+            Rejection::LastTriangles => &mut self.rejected.last_triangles,
         };
         *counter += 1;
     }

@@ -21,6 +21,7 @@
 use super::checks::Rejection;
 use super::counters::Counters;
 use super::incidence::Incidence;
+use super::ladder::Ladder;
 use super::locality::{in_locality_order, in_original_order, Renumbered};
 use super::nth_key::nth_key;
 use super::observer::{Contraction, Observer, Progress};
@@ -30,8 +31,8 @@ use super::options::{BoundaryMode, SimplifyOptions};
 use super::orientation::{InputSurface, Quick};
 use super::pair_set::PairSet;
 use super::pass_blocks::{
-    border_neighbours, contract_block, plain_checks, shared_planes, Around, BlockOutcome,
-    Candidate, Corners, Fixed, Slab, WaiverChange, BLOCK_VERTICES, REMOVED,
+    border_neighbours, contract_block, merging_faces, plain_checks, shared_planes, Around,
+    BlockOutcome, Candidate, Corners, Fixed, Slab, WaiverChange, BLOCK_VERTICES, REMOVED,
 };
 use super::pass_exact::PassExact;
 use super::placement::place_merged;
@@ -130,6 +131,8 @@ pub(super) struct Engine {
     /// The virtual pairs not yet contracted (`None` without them; the greedy order
     /// takes them into its own pairs).
     virtual_pairs: Option<PairSet>,
+    /// The ladder of relaxations' record ([`super::ladder`]).
+    pub ladder: Ladder,
 }
 
 /// A [`Fixed`] borrowing the fields of the engine `$engine`, with the orientation
@@ -246,6 +249,7 @@ impl Engine {
             deferred: Vec::new(),
             greedy: greedy::Greedy::default(),
             virtual_pairs: None,
+            ladder: Ladder::default(),
         };
         engine.set_block_vertices(BLOCK_VERTICES);
         // The incident lists first: the quadrics are summed along them.

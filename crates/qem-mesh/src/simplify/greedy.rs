@@ -8,8 +8,9 @@
 //! counters, event). After a contraction `b` → `a`, `b`'s triangles join `a`'s list
 //! ([`Incidence::merge`]), `b`'s pairs become `a`'s ([`PairSet::contract`]), and every
 //! pair at `a` is costed again and moved in the queue. A refused pair leaves the queue
-//! until one of its ends moves; a pair refused by the orientation check is queued
-//! again at the waivers' penalty.
+//! until one of its ends moves (or the ladder of relaxations queues every pair again,
+//! [`super::super::ladder`]); a pair refused by the orientation check is queued again at
+//! the waivers' penalty.
 
 use super::*;
 use crate::simplify::pair_queue::PairQueue;
@@ -80,6 +81,29 @@ impl Engine {
             target,
         });
         reason
+    }
+
+    /// Queues again, at its current cost, every pair that is not gone: those a check
+    /// refused left the queue (see the module's doc), and the ladder of relaxations
+    /// ([`super::super::ladder`]) asks them again under other checks.
+    pub(crate) fn requeue_every_pair(&mut self) {
+        let mut greedy = std::mem::take(&mut self.greedy);
+        if greedy.filled {
+            for id in 0..greedy.pairs.len() as u32 {
+                let [a, b] = greedy.pairs.ends(id);
+                if [a, b] == GONE {
+                    continue;
+                }
+                let (placed, _) = self.place(a, b);
+                let cost = if placed.cost.is_nan() {
+                    f64::INFINITY
+                } else {
+                    placed.cost
+                };
+                greedy.queue.push(id, cost);
+            }
+        }
+        self.greedy = greedy;
     }
 
     /// Lists and costs every pair (as a pass does) and queues it.

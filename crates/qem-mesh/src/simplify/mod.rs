@@ -4,7 +4,8 @@
 //! quadrics, triangles, the live triangles around each vertex) → face quadrics →
 //! vertex quadrics (+ border planes or locks) → virtual pairs (closer than t) → the
 //! order's loop { the next pair; its one attempt (lock order, placement, error bound,
-//! checks, orientation and waiver, contraction, counters, event) } → compact →
+//! checks, orientation and waiver, contraction, counters, event) }, and when no pair
+//! passes every check, the ladder of relaxations ([`RelaxationStep`]) → compact →
 //! report.
 //!
 //! The order is a policy of the one engine ([`ContractionOrder`]): `greedy` (a heap of
@@ -25,7 +26,8 @@
 //! mesh, and the pass-based order's block workers), `incidence` (per-vertex lists that contractions merge),
 //! `pair_set` and `pair_queue` (pairs that follow contractions, and the greedy queue),
 //! `placement` (where a merged vertex goes), `pass_exact` (the bookkeeping of
-//! [`QuadricMode::Exact`]), `checks` (the fold-over rules), `orientation` (the
+//! [`QuadricMode::Exact`]), `checks` (the fold-over rules), `ladder` (the relaxations
+//! when no pair passes every check), `orientation` (the
 //! orientation check's index), `waivers` (pairs the orientation check refused),
 //! `locality` (the vertex order), `nth_key` (the batch bound), `replay` (the store as
 //! the engine's oracle).
@@ -34,6 +36,7 @@ mod checks;
 mod counters;
 mod engine;
 mod incidence;
+mod ladder;
 mod locality;
 mod nth_key;
 mod observer;
@@ -49,6 +52,7 @@ mod report;
 mod settings;
 mod waivers;
 
+pub use ladder::{Constraint, Relaxation, RelaxationStep};
 pub use observer::{Contraction, NoObserver, Observer, Progress};
 pub use options::{
     BoundaryMode, ContractionOrder, Length, PlacementMode, QuadricMode, SimplifyOptions, Target,
@@ -202,10 +206,7 @@ pub fn simplify_levels(
         let clock = Instant::now();
         let stop_reason = match stopped_short {
             Some(reason) => reason,
-            None => match options.order {
-                ContractionOrder::Greedy => engine.run_greedy(target_triangles, observer),
-                ContractionOrder::Passes => engine.run_passes(target_triangles, observer),
-            },
+            None => engine.run_order_with_ladder(options, target_triangles, observer),
         };
         if stop_reason != StopReason::TargetReached {
             stopped_short = Some(stop_reason);
@@ -253,6 +254,9 @@ pub fn simplify_levels(
             cleanup,
             degenerate_faces_removed: zero_area_dropped + final_clean.report.repeated_index_faces,
             rejected: counters.rejected,
+            relaxations: engine.ladder.relaxations(),
+            stopped_by: (stop_reason == StopReason::NoValidPair)
+                .then_some(engine.ladder.stopped_by.unwrap_or(Constraint::NoPairs)),
             locked_vertices: counters.locked_vertices,
             faces_flipped: engine.flipped_faces(),
             timings,

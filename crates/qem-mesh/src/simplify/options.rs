@@ -258,6 +258,11 @@ pub struct SimplifyOptions {
     pub clean: CleanOptions,
     /// In which order pairs are contracted. Default: `ContractionOrder::Greedy`.
     pub order: ContractionOrder,
+    /// Stop when no pair passes every check, rather than climb the ladder of
+    /// relaxations ([`RelaxationStep`](super::RelaxationStep)): the run then stops
+    /// short with [`StopReason::NoValidPair`](super::StopReason::NoValidPair) where
+    /// the relaxed checks would have let it go on. Default: `false`.
+    pub strict: bool,
 }
 
 /// The default border-plane weight of [`BoundaryMode::Planes`]: a border plane then
@@ -325,6 +330,7 @@ impl SimplifyOptions {
         locked_vertices: Vec::new(),
         clean: CleanOptions::DEFAULT,
         order: ContractionOrder::Greedy,
+        strict: false,
     };
 
     /// [`DEFAULT`](Self::DEFAULT) in [`ContractionOrder::Passes`], with summed quadrics
@@ -372,6 +378,7 @@ impl SimplifyOptions {
         locked_vertices: Vec::new(),
         clean: CleanOptions::DEFAULT,
         order: ContractionOrder::Passes,
+        strict: false,
     };
 
     /// Sets [`target`](Self::target).
@@ -467,6 +474,12 @@ impl SimplifyOptions {
     /// Sets [`clean`](Self::clean).
     pub fn with_clean(mut self, clean: CleanOptions) -> Self {
         self.clean = clean;
+        self
+    }
+
+    /// Sets [`strict`](Self::strict).
+    pub fn with_strict(mut self, on: bool) -> Self {
+        self.strict = on;
         self
     }
 }

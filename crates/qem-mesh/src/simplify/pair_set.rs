@@ -40,6 +40,11 @@ impl PairSet {
         }
     }
 
+    /// How many pairs there were (ids run from 0 to this, gone ones included).
+    pub fn len(&self) -> usize {
+        self.ends.len()
+    }
+
     /// The current ends of pair `id` ([`GONE`] once it is gone).
     #[inline]
     pub fn ends(&self, id: u32) -> [u32; 2] {

@@ -218,9 +218,10 @@ impl<'a> Slab<'a> {
     }
 
     /// Contracts `b` into `a`, which moves to `world` (model units) with quadric `q`;
-    /// `around` holds the live triangles of `a` and of `b`. Returns how many triangles
-    /// were removed. (Exact quadrics' planes and the orientation check's state are the
-    /// caller's.)
+    /// `around` holds the live triangles of `a` and of `b`, and `merged` the faces that
+    /// the contraction merges and that go with it (see [`Engine::merged_away`]).
+    /// Returns how many triangles were removed. (Exact quadrics' planes and the
+    /// orientation check's state are the caller's.)
     pub fn contract(
         &mut self,
         fixed: &Fixed,
@@ -228,6 +229,7 @@ impl<'a> Slab<'a> {
         world: DVec3,
         q: Quadric,
         around: &[Vec<Around>; 2],
+        merged: &[u32],
     ) -> usize {
         let (sa, sb) = (self.slot_of(a), self.slot_of(b));
         self.moved_in[sa] = fixed.pass;
@@ -250,6 +252,19 @@ impl<'a> Slab<'a> {
                 let slot = self.triangle_slot_of(x.triangle);
                 self.triangles[slot] = x.corners.map(|c| if c == b { a } else { c });
             }
+        }
+        // Faces merged by the contraction (only where the ladder allows merges; see
+        // `Settings::allow_merges`). Their other corners count as moved: their
+        // triangles changed.
+        for &t in merged {
+            let slot = self.triangle_slot_of(t);
+            for c in self.triangles[slot] {
+                if let Some(v) = self.vertex_slot(c) {
+                    self.moved_in[v] = fixed.pass;
+                }
+            }
+            self.triangles[slot][0] = REMOVED;
+            removed += 1;
         }
         removed
     }
@@ -491,7 +506,7 @@ pub(super) fn contract_block(
         if fixed.has_virtual_pairs {
             out.merges.push([a, b]);
         }
-        let removed = slab.contract(fixed, [a, b], world, q, &around);
+        let removed = slab.contract(fixed, [a, b], world, q, &around, &[]);
         out.removed += removed;
         out.contracted += 1;
         out.counters.edge_contractions += 1;
@@ -524,7 +539,7 @@ pub(super) fn plain_checks(
     around: &[Vec<Around>; 2],
 ) -> Result<(), Rejection> {
     corners.fold_over(fixed, [a, b], world, around)?;
-    if would_merge_faces(a, b, around) {
+    if !fixed.settings.allow_merges && would_merge_faces(a, b, around) {
         return Err(Rejection::Merge);
     }
     // A virtual pair (no triangle on both) joins parts or closes a gap: it pinches
@@ -681,18 +696,37 @@ const SMALL_STAR: usize = 16;
 /// Whether contracting the edge `a b` would merge a triangle `a x y` with a triangle
 /// `b x y` (two faces on the same three vertices after it).
 fn would_merge_faces(a: u32, b: u32, around: &[Vec<Around>; 2]) -> bool {
-    around[1].iter().any(|y| {
+    !merging_faces(a, b, around).is_empty()
+}
+
+/// The faces that contracting `b` into `a` would merge, as pairs (a triangle `b x y`,
+/// a triangle `a x y`), each triangle in at most one pair; `around` holds the live
+/// triangles of `a` and of `b`.
+pub(super) fn merging_faces(
+    a: u32,
+    b: u32,
+    around: &[Vec<Around>; 2],
+) -> SmallVec<[(u32, u32); 2]> {
+    let mut pairs: SmallVec<[(u32, u32); 2]> = SmallVec::new();
+    for y in &around[1] {
         if y.corners.contains(&a) {
-            return false; // collapses with the pair
+            continue; // collapses with the pair
         }
         let mut others = y.corners.into_iter().filter(|&c| c != b);
-        match (others.next(), others.next()) {
-            (Some(p), Some(q)) => around[0]
-                .iter()
-                .any(|x| x.corners.contains(&p) && x.corners.contains(&q)),
-            _ => false,
+        let (Some(p), Some(q)) = (others.next(), others.next()) else {
+            continue;
+        };
+        let twin = around[0].iter().find(|x| {
+            !x.corners.contains(&b)
+                && x.corners.contains(&p)
+                && x.corners.contains(&q)
+                && !pairs.iter().any(|&(_, t)| t == x.triangle)
+        });
+        if let Some(x) = twin {
+            pairs.push((y.triangle, x.triangle));
         }
-    })
+    }
+    pairs
 }
 
 /// Whether contracting the edge `a b` (held by `shared` triangles) keeps every border

@@ -15,6 +15,12 @@
 //! - a plane whose support is down to one vertex meets no pair's two groups again,
 //!   and is forgotten.
 //!
+//! One exception: the two faces that a contraction merges away on the ladder of
+//! relaxations ([`RelaxationStep::MergedFaces`](super::RelaxationStep::MergedFaces))
+//! still have three current vertices in their supports, but no live triangle holds
+//! them, so they drop out of every later `Q_ab` and count twice there, as summed
+//! quadrics would. Only stuck runs merge faces; the brute-force tests run strict.
+//!
 //! So `Q_ab` = the face planes of the live triangles on both `a` and `b`, plus the
 //! segments joining them. A contraction renames the removed vertex in its segments at
 //! once and merges its list of segments into the kept vertex's ([`Incidence`]), so the

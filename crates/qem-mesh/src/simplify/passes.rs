@@ -148,7 +148,10 @@ impl Engine {
             .input_surface
             .as_ref()
             .is_none_or(|s| s.hint_count() == self.triangles.len());
+        // (Nor where merges are allowed: a merge removes faces at the pair's neighbours,
+        // and more than two triangles, which the blocks' bound on the target assumes.)
         !self.settings.any_locked
+            && !self.settings.allow_merges
             && hints_per_triangle
             && self.position.len() > self.block_vertices as usize
     }
@@ -544,7 +547,11 @@ impl Engine {
         if !self.probes.speculate_chunks {
             return false;
         }
-        self.input_surface.is_some() && self.chunk_contracted * 2 >= self.chunk_attempted
+        // Not where merges are allowed: a merge removes a face on both ends of a pair
+        // of the same round, which changes that pair's exact quadric.
+        self.input_surface.is_some()
+            && !self.settings.allow_merges
+            && self.chunk_contracted * 2 >= self.chunk_attempted
     }
 
     /// [`speculate`](Self::speculate) for one pair; `around` is scratch.

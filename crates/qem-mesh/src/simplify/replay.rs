@@ -18,7 +18,7 @@ use super::checks::is_zero_area;
 use super::observer::{Contraction, Observer};
 use super::settings::Settings;
 use super::SimplifyOptions;
-use crate::store::{MeshStore, VertexKey};
+use crate::store::{ContractLog, MeshStore, VertexKey};
 use crate::IndexedMesh;
 use qem_core::Frame;
 
@@ -49,6 +49,8 @@ pub struct StoreReplay {
     frame: Option<Frame>,
     zero_area_in: usize,
     contractions: usize,
+    /// Scratch: what the store's last contraction removed.
+    log: ContractLog,
 }
 
 impl StoreReplay {
@@ -173,28 +175,30 @@ impl Observer for StoreReplay {
         let step = self.contractions;
         self.contractions += 1;
         let faces_before = store.face_count();
-        match store.contract(a, b, c.world) {
-            Err(e) => {
-                self.failure = Some(format!(
-                    "contraction {step} ({} into {}): the store refused it: {e}",
-                    c.removed, c.kept
-                ));
-                return;
+        if let Err(e) = store.contract_logged(a, b, c.world, &mut self.log) {
+            self.failure = Some(format!(
+                "contraction {step} ({} into {}): the store refused it: {e}",
+                c.removed, c.kept
+            ));
+            return;
+        }
+        let (collapsed, merged) = (self.log.faces_collapsed.len(), self.log.faces_merged.len());
+        // The store keeps the kept vertex's face of each merged pair; the engine keeps
+        // it too, or (the ladder's merged faces) removes both.
+        if c.triangles_removed == collapsed + 2 * merged && merged > 0 {
+            for &(_, kept) in &self.log.faces_merged {
+                store.remove_face_and_bare_edges(kept);
             }
-            Ok(outcome) if outcome.faces_removed() != c.triangles_removed => {
-                self.failure = Some(format!(
-                    "contraction {step} ({} into {}): the engine removed {} triangles, \
-                     the store {} faces ({} collapsed, {} merged; {faces_before} before)",
-                    c.removed,
-                    c.kept,
-                    c.triangles_removed,
-                    outcome.faces_removed(),
-                    outcome.faces_collapsed,
-                    outcome.faces_merged
-                ));
-                return;
-            }
-            Ok(_) => {}
+        } else if c.triangles_removed != collapsed + merged {
+            self.failure = Some(format!(
+                "contraction {step} ({} into {}): the engine removed {} triangles, \
+                 the store {} faces ({collapsed} collapsed, {merged} merged; {faces_before} before)",
+                c.removed,
+                c.kept,
+                c.triangles_removed,
+                collapsed + merged,
+            ));
+            return;
         }
         if let Err(e) = store.validate() {
             self.failure = Some(format!("contraction {step}: the store broke: {e}"));

@@ -1,5 +1,6 @@
 //! What a run did ([`SimplifyReport`]), why it stopped, and why it could not run.
 
+use super::ladder::{Constraint, Relaxation};
 use crate::clean::CleanReport;
 use crate::{IndexedMesh, InputError};
 use std::fmt;
@@ -93,6 +94,14 @@ pub struct SimplifyReport {
     pub degenerate_faces_removed: usize,
     /// Contractions refused, by reason.
     pub rejected: Refusals,
+    /// The steps of the ladder of relaxations the run climbed because no pair passed
+    /// every check, in order, with the contractions made under each (empty when it
+    /// never got stuck; see [`RelaxationStep`](super::RelaxationStep)).
+    pub relaxations: Vec<Relaxation>,
+    /// With [`StopReason::NoValidPair`]: the constraint that stopped the run (what
+    /// refused the most pairs at the top of the ladder, or [`Constraint::Strict`]);
+    /// `None` for every other stop reason.
+    pub stopped_by: Option<Constraint>,
     /// Vertices of the cleaned input that were locked (by
     /// [`locked_vertices`](super::SimplifyOptions::locked_vertices) or by
     /// [`BoundaryMode::Locked`](super::BoundaryMode::Locked)).
@@ -101,7 +110,9 @@ pub struct SimplifyReport {
     /// face they descend from (each output face is a moved input face). The fold-over
     /// check ([`max_normal_angle`](super::SimplifyOptions::max_normal_angle) below 180°)
     /// refuses every contraction that would make one, so this is 0 unless the check is
-    /// off; it is a cheap self-check, not a comparison with the input surface.
+    /// off or the ladder of relaxations climbed
+    /// [`RelaxationStep::FlippedFaces`](super::RelaxationStep::FlippedFaces); it is a
+    /// cheap self-check, not a comparison with the input surface.
     pub faces_flipped: usize,
     /// Wall time per phase.
     pub timings: Timings,
@@ -194,6 +205,9 @@ pub struct Refusals {
     /// queued again at a penalty and may be contracted later, when everything else
     /// costs more; each refusal is counted.
     pub orientation: usize,
+    /// Contractions refused because they would have removed the last triangles: the
+    /// output keeps at least one.
+    pub last_triangles: usize,
 }
 
 impl Refusals {
@@ -208,8 +222,17 @@ impl Refusals {
             border,
             merge,
             orientation,
+            last_triangles,
         } = *self;
-        degenerate + flip + sliver + topology + locked + border + merge + orientation
+        degenerate
+            + flip
+            + sliver
+            + topology
+            + locked
+            + border
+            + merge
+            + orientation
+            + last_triangles
     }
 
     /// Adds `other`'s counts to these.
@@ -222,6 +245,22 @@ impl Refusals {
         self.border += other.border;
         self.merge += other.merge;
         self.orientation += other.orientation;
+        self.last_triangles += other.last_triangles;
+    }
+
+    /// These counts less `earlier`'s (an earlier copy of the same counters).
+    pub(crate) fn minus(&self, earlier: &Refusals) -> Refusals {
+        Refusals {
+            degenerate: self.degenerate - earlier.degenerate,
+            flip: self.flip - earlier.flip,
+            sliver: self.sliver - earlier.sliver,
+            topology: self.topology - earlier.topology,
+            locked: self.locked - earlier.locked,
+            border: self.border - earlier.border,
+            merge: self.merge - earlier.merge,
+            orientation: self.orientation - earlier.orientation,
+            last_triangles: self.last_triangles - earlier.last_triangles,
+        }
     }
 }
 

@@ -1,6 +1,7 @@
 //! The one place where options become settings: what the engine reads, in the form
 //! it reads it (normalised units, cosines, flags).
 
+use super::ladder::RelaxationStep;
 use super::options::{BoundaryMode, PlacementMode, SimplifyOptions};
 use crate::clean::min_double_area;
 use qem_core::Frame;
@@ -24,6 +25,9 @@ pub(super) struct Settings {
     pub world_may_underflow: bool,
     /// Cosine of the largest allowed normal turn; `None` when the check is off.
     pub min_normal_cos: Option<f64>,
+    /// Whether a moved face must not point more than 90° away from the input face it
+    /// descends from (with the fold-over check on).
+    pub face_input: bool,
     /// The sliver threshold; `None` when the check is off.
     pub min_quality: Option<f64>,
     pub preserve_topology: bool,
@@ -35,6 +39,9 @@ pub(super) struct Settings {
     pub keep_border_loops: bool,
     /// Whether any vertex is locked (skips the lock checks entirely when not).
     pub any_locked: bool,
+    /// Whether an edge contraction may merge two faces `a x y` and `b x y` (both are
+    /// then removed): only on the ladder's [`RelaxationStep::MergedFaces`].
+    pub allow_merges: bool,
 }
 
 impl Settings {
@@ -52,6 +59,7 @@ impl Settings {
             // ~1e-308, so only a model smaller than ~1e-150 can be affected.
             world_may_underflow: frame.world_diagonal() < WORLD_UNDERFLOW_DIAGONAL,
             min_normal_cos: (angle < 180.0).then(|| angle.to_radians().cos()),
+            face_input: angle < 180.0,
             min_quality: (options.min_triangle_quality > 0.0)
                 .then_some(options.min_triangle_quality),
             preserve_topology: options.preserve_topology,
@@ -62,6 +70,25 @@ impl Settings {
             },
             keep_border_loops: options.boundary != BoundaryMode::Free,
             any_locked: false,
+            allow_merges: false,
         }
+    }
+
+    /// These settings with the relaxations of the ladder's `steps` (see
+    /// [`super::ladder`]: the steps a run may climb, up to the one it is on).
+    pub(super) fn relaxed(&self, steps: &[RelaxationStep]) -> Settings {
+        let mut relaxed = *self;
+        for &s in steps {
+            match s {
+                RelaxationStep::FoldOver => {
+                    relaxed.min_normal_cos = None;
+                    relaxed.min_quality = None;
+                }
+                RelaxationStep::BorderLoops => relaxed.keep_border_loops = false,
+                RelaxationStep::MergedFaces => relaxed.allow_merges = true,
+                RelaxationStep::FlippedFaces => relaxed.face_input = false,
+            }
+        }
+        relaxed
     }
 }

@@ -340,6 +340,25 @@ impl MeshStore {
             .find(|&f| self.faces[f].has_vertex(y))
     }
 
+    /// Removes face `f`, and each of its edges that holds no other face: what a
+    /// simplifier does with the two faces a contraction merges when it keeps neither
+    /// (the ladder of relaxations' merged faces, see
+    /// [`RelaxationStep::MergedFaces`](crate::simplify::RelaxationStep::MergedFaces)).
+    /// Vertices stay, even when no face is left on them. Does nothing when `f` is not
+    /// in the store.
+    pub fn remove_face_and_bare_edges(&mut self, f: FaceKey) {
+        let Some(face) = self.faces.get(f) else {
+            return;
+        };
+        let edges = face.edge_keys();
+        self.remove_face(f);
+        for e in edges {
+            if self.edges.contains_key(e) && self.fan(e).is_empty() {
+                self.remove_edge(e);
+            }
+        }
+    }
+
     /// Removes face `f` from the fans of its edges and from the store.
     fn remove_face(&mut self, f: FaceKey) {
         if let Some(face) = self.faces.remove(f) {

@@ -282,3 +282,12 @@ pub fn simplify_replayed(
     }
     Ok(out)
 }
+
+/// Whether a run made contractions on the ladder of relaxations' last step, the only
+/// one that may leave a face facing away from its input face.
+pub fn climbed_flipped_faces(report: &qem_mesh::simplify::SimplifyReport) -> bool {
+    report
+        .relaxations
+        .iter()
+        .any(|r| r.step == qem_mesh::simplify::RelaxationStep::FlippedFaces && r.contractions > 0)
+}

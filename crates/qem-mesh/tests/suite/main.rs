@@ -17,6 +17,7 @@ mod io_corpus;
 mod io_errors;
 #[cfg(feature = "io")]
 mod io_lenient;
+mod ladder;
 mod measure;
 mod numeric_extremes;
 #[cfg(feature = "io")]

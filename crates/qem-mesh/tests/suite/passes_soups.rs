@@ -174,7 +174,7 @@ fn check_fast(
             if r.stop_reason == StopReason::TargetReached {
                 prop_assert!(r.triangles_out <= r.target_triangles);
             }
-            if o.max_normal_angle < 180.0 {
+            if o.max_normal_angle < 180.0 && !common::climbed_flipped_faces(r) {
                 prop_assert_eq!(r.faces_flipped, 0);
             }
             // One event per contraction; a removed vertex never comes back, and a
@@ -264,7 +264,11 @@ proptest! {
     ) {
         prop_assert_eq!(border_loops(&mesh), 1);
         let boundary = if locked { BoundaryMode::Locked } else { BoundaryMode::Planes(1.0) };
-        let o = SimplifyOptions::FAST.with_target(Target::Ratio(r)).with_boundary(boundary);
+        // Strict: a stuck run may pinch a loop on the ladder of relaxations.
+        let o = SimplifyOptions::FAST
+            .with_target(Target::Ratio(r))
+            .with_boundary(boundary)
+            .with_strict(true);
         if let Some(out) = check_fast(&mesh, &o)? {
             prop_assert_eq!(border_loops(&out), 1);
         }
@@ -292,7 +296,9 @@ proptest! {
                 assert_valid(&out.mesh, mesh.triangle_count());
                 let zero = zero_area_faces_in_input_frame(&mesh, &o.clean, &out.mesh);
                 prop_assert!(zero.is_empty(), "zero-area faces {:?}", zero);
-                prop_assert_eq!(out.report.faces_flipped, 0);
+                if !common::climbed_flipped_faces(&out.report) {
+                    prop_assert_eq!(out.report.faces_flipped, 0);
+                }
             }
         }
         let second = simplify(&mesh, &o);

@@ -44,6 +44,13 @@ class CleanOptions(TypedDict, total=False):
     drop_unreferenced: bool
     """Drop vertices no face uses. Default: True."""
 
+class Relaxation(TypedDict):
+    """A step of the ladder of relaxations that a run climbed."""
+
+    step: Literal["fold_over", "border_loops", "merged_faces"]
+    contractions: int
+    """Contractions made while the step was in force."""
+
 class Report(TypedDict):
     """What a simplification did (the keys of ``qem simplify --report``)."""
 
@@ -69,7 +76,13 @@ class Report(TypedDict):
     degenerate_faces_removed: int
     rejected: dict[str, int]
     """Contractions refused, by reason: degenerate, flip, sliver, topology, locked,
-    border, merge, orientation."""
+    border, merge, orientation, last_triangles."""
+    relaxations: list[Relaxation]
+    """The steps of the ladder of relaxations the run climbed because no pair passed
+    every check, in order (empty when it never got stuck)."""
+    stopped_by: Literal["strict", "preserve_topology", "locks", "locked_boundary",
+                        "zero_area", "last_triangles", "no_pairs"] | None
+    """With stop_reason "no_valid_pair": what stopped the run; None otherwise."""
     locked_vertices: int
     faces_flipped: int
     timings_ms: dict[str, float]
@@ -115,6 +128,7 @@ def simplify(
     locked_vertices: Sequence[int] | npt.NDArray[np.integer[Any]] = (),
     clean: CleanOptions | None = None,
     order: Literal["greedy", "passes"] = "greedy",
+    strict: bool = False,
 ) -> Tuple[Vertices, Faces, Report]:
     """Simplifies a triangle mesh by Garland-Heckbert pair contraction.
 
@@ -166,6 +180,13 @@ def simplify(
       defaults.
     - ``order``: ``"greedy"`` (cheapest pair first) or ``"passes"`` (batches of the
       cheapest pairs that share no vertex); every other option works in both.
+    - ``strict``: stop when no pair passes every check, instead of climbing the ladder
+      of relaxations (the fold-over rules, then the border-loop rule, then merged
+      faces, each only when the stricter rules have nothing left; the report's
+      ``relaxations`` lists the steps climbed and ``stopped_by`` what stopped a run
+      with stop_reason ``"no_valid_pair"``). Options you set yourself
+      (``preserve_topology``, ``locked_vertices``, ``boundary="locked"``,
+      ``max_error``) are never relaxed.
 
     Raises QemError (a ValueError) when the input or the options are refused, with
     qem's message; TypeError for an argument of the wrong kind or an unknown option.

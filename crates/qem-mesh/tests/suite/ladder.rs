@@ -1,0 +1,268 @@
+//! The ladder of relaxations (issue 28): a run that finds no pair passing every check
+//! relaxes them, step by step, instead of stopping short; `strict` and the user's own
+//! constraints stop it, and the report says what did.
+
+use crate::common::{assert_valid, concat, simplify_replayed, topology, uv_sphere};
+use qem_mesh::simplify::{
+    simplify, BoundaryMode, Constraint, ContractionOrder, RelaxationStep, SimplifyOptions,
+    StopReason, Target,
+};
+use qem_mesh::IndexedMesh;
+
+const ORDERS: [ContractionOrder; 2] = [ContractionOrder::Greedy, ContractionOrder::Passes];
+
+/// `n` separate closed tetrahedra of slightly different sizes in a row: no edge of one
+/// can be contracted without merging two of its faces, so without the ladder nothing
+/// moves.
+fn tetrahedra(n: u32) -> IndexedMesh {
+    let parts: Vec<IndexedMesh> = (0..n)
+        .map(|i| {
+            let (x, s) = (3.0 * i as f64, 1.0 + 0.01 * i as f64);
+            IndexedMesh::new(
+                vec![[x, 0.0, 0.0], [x + s, 0.0, 0.0], [x, s, 0.0], [x, 0.0, s]],
+                vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+            )
+        })
+        .collect();
+    concat(&parts)
+}
+
+fn options(order: ContractionOrder, target: Target) -> SimplifyOptions {
+    SimplifyOptions::DEFAULT
+        .with_order(order)
+        .with_target(target)
+}
+
+#[test]
+fn strict_runs_stop_where_every_check_refuses() {
+    let mesh = tetrahedra(50);
+    for order in ORDERS {
+        let out = simplify(&mesh, &options(order, Target::Ratio(0.1)).with_strict(true))
+            .expect("simplifies");
+        assert_eq!(out.mesh.triangle_count(), 200, "{order:?}");
+        assert_eq!(out.report.stop_reason, StopReason::NoValidPair);
+        assert_eq!(out.report.stopped_by, Some(Constraint::Strict));
+        assert!(out.report.relaxations.is_empty());
+        assert!(out.report.rejected.merge > 0, "{order:?}");
+    }
+}
+
+#[test]
+fn separate_tetrahedra_reach_the_target_by_merged_faces() {
+    let mesh = tetrahedra(50);
+    for order in ORDERS {
+        let out =
+            simplify_replayed(&mesh, &options(order, Target::Ratio(0.1))).expect("simplifies");
+        let what = format!("{order:?}");
+        assert_eq!(out.report.stop_reason, StopReason::TargetReached, "{what}");
+        assert_eq!(out.report.stopped_by, None, "{what}");
+        assert_eq!(out.mesh.triangle_count(), 20, "{what}: 5 tetrahedra left");
+        assert_valid(&out.mesh, 200);
+        let steps: Vec<RelaxationStep> = out.report.relaxations.iter().map(|r| r.step).collect();
+        assert_eq!(
+            steps,
+            RelaxationStep::ALL[..3],
+            "{what}: up to merged faces"
+        );
+        let merged = &out.report.relaxations[2];
+        assert_eq!(
+            merged.contractions, 45,
+            "{what}: one contraction per tetrahedron"
+        );
+        // Each tetrahedron goes whole: the 5 left are closed (no border edge).
+        let (euler, parts, borders) = topology(&out.mesh);
+        assert_eq!((euler, parts, borders), (10, 5, 0), "{what}");
+        // The smallest went first (cost order is kept under the relaxation).
+        let smallest_left = out
+            .mesh
+            .positions
+            .iter()
+            .map(|p| p[0])
+            .fold(f64::INFINITY, f64::min);
+        assert!(
+            smallest_left >= 3.0 * 45.0 - 1e-9,
+            "{what}: {smallest_left}"
+        );
+    }
+}
+
+#[test]
+fn a_target_of_nothing_ends_at_one_triangle_and_says_why() {
+    let mesh = tetrahedra(3);
+    for order in ORDERS {
+        let out =
+            simplify_replayed(&mesh, &options(order, Target::Triangles(0))).expect("simplifies");
+        assert_eq!(out.mesh.triangle_count(), 1, "{order:?}");
+        assert_valid(&out.mesh, 12);
+        assert_eq!(out.report.stop_reason, StopReason::NoValidPair);
+        assert_eq!(out.report.stopped_by, Some(Constraint::LastTriangles));
+        assert!(out.report.rejected.last_triangles > 0);
+    }
+}
+
+#[test]
+fn topology_preservation_is_never_relaxed() {
+    let mesh = tetrahedra(10);
+    for order in ORDERS {
+        let out = simplify(
+            &mesh,
+            &options(order, Target::Ratio(0.1)).with_preserve_topology(true),
+        )
+        .expect("simplifies");
+        assert_eq!(out.mesh.triangle_count(), 40, "{order:?}");
+        assert_eq!(out.report.stopped_by, Some(Constraint::PreserveTopology));
+        let steps: Vec<RelaxationStep> = out.report.relaxations.iter().map(|r| r.step).collect();
+        assert_eq!(
+            steps,
+            [RelaxationStep::FoldOver, RelaxationStep::FlippedFaces],
+            "{order:?}: neither border loops nor merged faces"
+        );
+        assert!(out.report.relaxations.iter().all(|r| r.contractions == 0));
+    }
+}
+
+#[test]
+fn locked_vertices_are_never_relaxed() {
+    let mesh = tetrahedra(10);
+    let all: Vec<u32> = (0..mesh.vertex_count() as u32).collect();
+    for order in ORDERS {
+        let out = simplify(
+            &mesh,
+            &options(order, Target::Ratio(0.1)).with_locked_vertices(all.clone()),
+        )
+        .expect("simplifies");
+        assert_eq!(out.mesh.triangle_count(), 40, "{order:?}");
+        assert_eq!(out.report.stopped_by, Some(Constraint::Locks), "{order:?}");
+        // One corner of each tetrahedron locked: the merges that would remove a face
+        // at a locked corner are refused, the others go on.
+        let some: Vec<u32> = (0..10).map(|i| 4 * i + 3).collect();
+        let out = simplify_replayed(
+            &mesh,
+            &options(order, Target::Ratio(0.1)).with_locked_vertices(some),
+        )
+        .expect("simplifies");
+        assert_valid(&out.mesh, 40);
+        for i in 0..10 {
+            let p = [3.0 * i as f64, 0.0, 1.0 + 0.01 * i as f64];
+            assert!(
+                out.mesh.positions.contains(&p),
+                "{order:?}: locked corner {i} kept"
+            );
+        }
+    }
+}
+
+/// A flat square frame around a square hole: 8 triangles, two border loops, every
+/// vertex on a border. Below 6 triangles a loop must be pinched or closed.
+fn frame() -> IndexedMesh {
+    let positions = vec![
+        [0.0, 0.0, 0.0],
+        [3.0, 0.0, 0.0],
+        [3.0, 3.0, 0.0],
+        [0.0, 3.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [2.0, 1.0, 0.0],
+        [2.0, 2.0, 0.0],
+        [1.0, 2.0, 0.0],
+    ];
+    let mut triangles = Vec::new();
+    for i in 0..4u32 {
+        let (o, p, q, r) = (i, (i + 1) % 4, 4 + i, 4 + (i + 1) % 4);
+        triangles.push([o, p, r]);
+        triangles.push([o, r, q]);
+    }
+    IndexedMesh::new(positions, triangles)
+}
+
+#[test]
+fn a_locked_boundary_is_never_relaxed() {
+    let mesh = frame();
+    for order in ORDERS {
+        let locked = simplify(
+            &mesh,
+            &options(order, Target::Triangles(2)).with_boundary(BoundaryMode::Locked),
+        )
+        .expect("simplifies");
+        assert_eq!(locked.mesh.triangle_count(), 8, "{order:?}");
+        assert_eq!(
+            locked.report.stopped_by,
+            Some(Constraint::Locks),
+            "{order:?}"
+        );
+        let strict = simplify(
+            &mesh,
+            &options(order, Target::Triangles(2)).with_strict(true),
+        )
+        .expect("simplifies");
+        assert!(strict.mesh.triangle_count() >= 6, "{order:?}");
+        let free =
+            simplify_replayed(&mesh, &options(order, Target::Triangles(2))).expect("simplifies");
+        assert_valid(&free.mesh, 8);
+        assert!(
+            free.mesh.triangle_count() <= 2,
+            "{order:?}: {}",
+            free.mesh.triangle_count()
+        );
+        assert!(
+            free.report
+                .relaxations
+                .iter()
+                .any(|r| r.step == RelaxationStep::BorderLoops && r.contractions > 0),
+            "{order:?}: {:?}",
+            free.report.relaxations
+        );
+    }
+}
+
+#[test]
+fn a_clean_closed_mesh_never_climbs() {
+    let mesh = uv_sphere([0.0; 3], 1.0, 24, 48);
+    for order in ORDERS {
+        for ratio in [0.1, 0.01] {
+            let out = simplify(&mesh, &options(order, Target::Ratio(ratio))).expect("simplifies");
+            assert_eq!(
+                out.report.stop_reason,
+                StopReason::TargetReached,
+                "{order:?} {ratio}"
+            );
+            assert!(
+                out.report.relaxations.is_empty(),
+                "{order:?} {ratio}: {:?}",
+                out.report.relaxations
+            );
+            let strict = simplify(
+                &mesh,
+                &options(order, Target::Ratio(ratio)).with_strict(true),
+            )
+            .expect("simplifies");
+            assert_eq!(
+                strict.mesh, out.mesh,
+                "{order:?} {ratio}: the ladder changed nothing"
+            );
+        }
+    }
+}
+
+#[test]
+fn stuck_parts_beside_a_sphere_reach_the_target_with_a_valid_output() {
+    // A sphere with tetrahedra around it: the sphere goes first, then the
+    // tetrahedra need the ladder.
+    let mesh = concat(&[uv_sphere([-5.0, 0.0, 0.0], 1.0, 8, 16), tetrahedra(20)]);
+    let n = mesh.triangle_count();
+    for order in ORDERS {
+        let out =
+            simplify_replayed(&mesh, &options(order, Target::Triangles(40))).expect("simplifies");
+        assert_valid(&out.mesh, n);
+        assert_eq!(
+            out.report.stop_reason,
+            StopReason::TargetReached,
+            "{order:?}"
+        );
+        assert!(out.mesh.triangle_count() <= 40, "{order:?}");
+        assert!(
+            out.mesh.triangle_count() >= 36,
+            "{order:?}: {}",
+            out.mesh.triangle_count()
+        );
+    }
+}
