@@ -61,7 +61,8 @@ pub struct SimplifyFlags {
     pub virtual_pairs: VirtualPairsFlag,
     /// Weight of the constraint planes through border edges (perpendicular to the
     /// border's face), relative to the faces' own planes; 0 lets borders move freely
-    /// (border loops are still never pinched or closed).
+    /// and turns the loop rule off (above 0, border loops are never pinched or closed
+    /// unless the run is stuck: see --strict).
     #[arg(long, default_value_t = DEFAULT_BOUNDARY_WEIGHT, value_parser = parse_non_negative,
           conflicts_with = "lock_boundary")]
     pub boundary_weight: f64,

@@ -112,7 +112,8 @@ pub enum BoundaryMode {
     /// Also the *loop rule*: an edge whose two ends are on a border must be a border
     /// edge itself, and may not close a loop of three border edges, so border loops are
     /// never pinched, merged or closed (counted in
-    /// [`Refusals::border`](super::Refusals::border)).
+    /// [`Refusals::border`](super::Refusals::border)), unless the run is stuck and the
+    /// ladder of relaxations climbs [`RelaxationStep::BorderLoops`](super::RelaxationStep::BorderLoops).
     Planes(f64),
     /// Border vertices never move and are never removed, like [locked
     /// vertices](SimplifyOptions::locked_vertices): the border comes out exactly as it

@@ -167,7 +167,8 @@ def simplify(
     - ``quadrics``: ``"sum"`` (Garland-Heckbert's Q_a + Q_b) or ``"exact"`` (the union of
       the plane sets: every plane counts once).
     - ``boundary``: a number w (border constraint planes of weight w; 0 lets borders move,
-      though border loops are still never pinched or closed), ``"free"`` (no planes, no
+      though border loops are never pinched or closed unless the run is stuck, see
+      ``strict``), ``"free"`` (no planes, no
       loop rule) or ``"locked"`` (border vertices never move).
     - ``max_normal_angle``: refuse a contraction that turns a surviving face's normal by
       more than this many degrees; 180 turns the check off.
