@@ -8,7 +8,7 @@ use super::*;
 
 impl Engine {
     /// Checks and contracts the edge `a b` (both unmoved in this pass); `live` is the
-    /// live triangle count.
+    /// live triangle count and `target` the run's.
     ///
     /// `speculation` is what [`speculate`](Self::speculate) found for the pair.
     ///
@@ -19,7 +19,7 @@ impl Engine {
         &mut self,
         a: u32,
         b: u32,
-        live: usize,
+        [live, target]: [usize; 2],
         virtual_allowed: bool,
         speculation: Option<&Speculation>,
         observer: &mut dyn Observer,
@@ -47,7 +47,8 @@ impl Engine {
             (b, a)
         };
         // Never contract the last faces away: the output must keep a triangle.
-        let merged = self.merged_away(a, b, &around, live - shared.min(live));
+        let left = live - shared.min(live);
+        let merged = self.merged_away(a, b, &around, [left, target]);
         let attempt = if shared + merged.len() >= live {
             self.counters.reject(Rejection::LastTriangles);
             Attempt::Refused
@@ -66,21 +67,23 @@ impl Engine {
     /// The faces that contracting `b` into `a` removes besides the triangles on both,
     /// where the ladder allows merges (none otherwise): each pair of faces `b x y` and
     /// `a x y` that would lie on the same three vertices goes, both of them; but when
-    /// that would leave none of the `left` triangles that the collapse leaves, the face
-    /// `a x y` of each pair stays (a closed part's last faces: a tetrahedron goes down
-    /// to one triangle, not to none).
+    /// that would leave none of the `left` triangles that the collapse leaves, or fewer
+    /// than the run's `target`, the face `a x y` of each pair stays (a closed part's
+    /// last faces: a tetrahedron goes down to one triangle, not to none; and a run
+    /// near its target passes it by as little as it can).
     pub(super) fn merged_away(
         &self,
         a: u32,
         b: u32,
         around: &[Vec<Around>; 2],
-        left: usize,
+        [left, target]: [usize; 2],
     ) -> SmallVec<[u32; 4]> {
         if !self.settings.allow_merges {
             return SmallVec::new();
         }
         let pairs = merging_faces(a, b, around);
-        if 2 * pairs.len() < left {
+        let both = 2 * pairs.len();
+        if both < left && left - both >= target {
             pairs
                 .iter()
                 .flat_map(|&(from_b, from_a)| [from_b, from_a])

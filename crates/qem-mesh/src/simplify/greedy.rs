@@ -51,7 +51,7 @@ impl Engine {
             };
             let [a, b] = greedy.pairs.ends(id);
             let virtual_allowed = greedy.virtual_ok[id as usize];
-            match self.try_contract(a, b, live, virtual_allowed, None, observer) {
+            match self.try_contract(a, b, [live, target], virtual_allowed, None, observer) {
                 Attempt::Contracted {
                     removed,
                     kept,

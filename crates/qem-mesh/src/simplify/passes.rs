@@ -392,7 +392,7 @@ impl Engine {
                     .get(k % SPECULATION_CHUNK)
                     .and_then(Option::as_ref);
                 let Candidate { a, b, .. } = self.candidates[i as usize];
-                match self.try_contract(a, b, live_count, true, speculation, observer) {
+                match self.try_contract(a, b, [live_count, target], true, speculation, observer) {
                     Attempt::Contracted { removed, .. } => {
                         live_count -= removed;
                         contracted += 1;
