@@ -155,3 +155,59 @@ fn help_lists_the_quality_flags_with_defaults() {
     }
     assert!(help.contains("[default: 90]"), "{help}");
 }
+
+/// 30 separate tetrahedra as an OBJ: stuck without the ladder of relaxations.
+fn tetrahedra_obj(path: &std::path::Path) {
+    let mut text = String::new();
+    for i in 0..30 {
+        let (x, e) = (3.0 * f64::from(i), 1.0 + 0.01 * f64::from(i));
+        text += &format!("v {x} 0 0\nv {} 0 0\nv {x} {e} 0\nv {x} 0 {e}\n", x + e);
+        let v = 4 * i + 1;
+        let (a, b, c, d) = (v, v + 1, v + 2, v + 3);
+        text += &format!("f {a} {c} {b}\nf {a} {b} {d}\nf {a} {d} {c}\nf {b} {c} {d}\n");
+    }
+    std::fs::write(path, text).expect("writes");
+}
+
+/// A stuck run climbs the ladder and says so in its report and its summary line;
+/// `--strict` stops where the checks do and names itself as what stopped the run.
+#[test]
+fn strict_and_the_ladder_show_in_the_report() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let (input, out, report) = (
+        dir.path().join("tets.obj"),
+        dir.path().join("out.obj"),
+        dir.path().join("r.json"),
+    );
+    tetrahedra_obj(&input);
+    let run = |extra: &[&str]| {
+        let mut args = vec!["simplify", s(&input), "-o", s(&out), "--ratio", "0.1"];
+        args.extend_from_slice(&["--report", s(&report)]);
+        args.extend_from_slice(extra);
+        let o = qem(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        (common::json(&report), stderr(&o))
+    };
+    let (j, line) = run(&[]);
+    assert_eq!(j["stop_reason"], "target_reached");
+    assert_eq!(j["triangles_out"], 12);
+    assert!(j["stopped_by"].is_null());
+    let steps: Vec<&str> = j["relaxations"]
+        .as_array()
+        .expect("a list")
+        .iter()
+        .map(|r| r["step"].as_str().expect("a name"))
+        .collect();
+    assert_eq!(steps, ["fold_over", "border_loops", "merged_faces"]);
+    assert_eq!(j["relaxations"][2]["contractions"], 27);
+    assert!(
+        line.contains("relaxed: fold_over 0, border_loops 0, merged_faces 27"),
+        "{line}"
+    );
+    let (j, line) = run(&["--strict"]);
+    assert_eq!(j["stop_reason"], "no_valid_pair");
+    assert_eq!(j["stopped_by"], "strict");
+    assert_eq!(j["triangles_out"], 120);
+    assert_eq!(j["relaxations"].as_array().map(Vec::len), Some(0));
+    assert!(line.contains("(no_valid_pair: strict)"), "{line}");
+}
