@@ -392,7 +392,18 @@ impl Engine {
                     .get(k % SPECULATION_CHUNK)
                     .and_then(Option::as_ref);
                 let Candidate { a, b, .. } = self.candidates[i as usize];
-                match self.try_contract(a, b, [live_count, target], true, speculation, observer) {
+                // A pair on no common triangle is attempted as a virtual pair only in
+                // a run that has them: an edge whose faces a merge took earlier in the
+                // round is none.
+                let virtual_allowed = self.virtual_pairs.is_some();
+                match self.try_contract(
+                    a,
+                    b,
+                    [live_count, target],
+                    virtual_allowed,
+                    speculation,
+                    observer,
+                ) {
                     Attempt::Contracted { removed, .. } => {
                         live_count -= removed;
                         contracted += 1;

@@ -57,6 +57,10 @@ fn separate_tetrahedra_reach_the_target_by_merged_faces() {
         assert_eq!(out.report.stop_reason, StopReason::TargetReached, "{what}");
         assert_eq!(out.report.stopped_by, None, "{what}");
         assert_eq!(out.mesh.triangle_count(), 20, "{what}: 5 tetrahedra left");
+        assert_eq!(
+            out.report.virtual_contractions, 0,
+            "{what}: no virtual pairs asked for"
+        );
         assert_valid(&out.mesh, 200);
         let steps: Vec<RelaxationStep> = out.report.relaxations.iter().map(|r| r.step).collect();
         assert_eq!(
