@@ -214,14 +214,14 @@ impl Engine {
         target: usize,
         observer: &mut dyn Observer,
     ) -> StopReason {
-        let strict = self.settings;
+        let every_check = self.settings;
         self.ladder.stopped_by = None;
         let steps: Vec<(usize, RelaxationStep)> = RelaxationStep::ALL
             .into_iter()
             .enumerate()
             .filter(|(_, step)| !options.strict && step.allowed(options))
             .collect();
-        let allowed: Vec<RelaxationStep> = steps.iter().map(|&(_, step)| step).collect();
+        let climbable: Vec<RelaxationStep> = steps.iter().map(|&(_, step)| step).collect();
         let mut reason = self.run_order(options.order, target, observer);
         let mut climb = 0;
         while reason == StopReason::NoValidPair {
@@ -229,18 +229,18 @@ impl Engine {
                 break;
             };
             // This step and the allowed ones below it, never one the options forbid.
-            self.settings = strict.relaxed(&allowed[..=climb]);
+            self.settings = every_check.relaxed(&climbable[..=climb]);
             self.ladder.contractions[slot].get_or_insert(0);
             self.retry(options.order);
             let (before, refused_before) = (self.counters.contractions(), self.counters.rejected);
             reason = self.run_order(options.order, target, observer);
-            let allowed = self.counters.contractions() - before;
-            *self.ladder.contractions[slot].get_or_insert(0) += allowed;
-            self.settings = strict;
+            let made = self.counters.contractions() - before;
+            *self.ladder.contractions[slot].get_or_insert(0) += made;
+            self.settings = every_check;
             if reason != StopReason::NoValidPair {
                 break;
             }
-            if allowed == 0 {
+            if made == 0 {
                 if climb + 1 == steps.len() {
                     let refused = self.counters.rejected.minus(&refused_before);
                     self.ladder.stopped_by = Some(Constraint::behind(&refused, options));
