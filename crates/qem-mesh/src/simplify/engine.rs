@@ -21,7 +21,6 @@
 use super::checks::Rejection;
 use super::counters::Counters;
 use super::incidence::Incidence;
-use super::ladder::Ladder;
 use super::locality::{in_locality_order, in_original_order, Renumbered};
 use super::nth_key::nth_key;
 use super::observer::{Contraction, Observer, Progress};
@@ -36,6 +35,7 @@ use super::pass_blocks::{
 };
 use super::pass_exact::PassExact;
 use super::placement::place_merged;
+use super::relaxation::Ladder;
 use super::report::StopReason;
 use super::settings::Settings;
 use super::waivers::{penalised, Waivers};

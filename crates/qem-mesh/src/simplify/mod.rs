@@ -27,7 +27,8 @@
 //! `pair_set` and `pair_queue` (pairs that follow contractions, and the greedy queue),
 //! `placement` (where a merged vertex goes), `pass_exact` (the bookkeeping of
 //! [`QuadricMode::Exact`]), `checks` (the fold-over rules), `ladder` (the relaxations
-//! when no pair passes every check), `orientation` (the
+//! when no pair passes every check) and `relaxation` (its steps and what the report
+//! says of them), `orientation` (the
 //! orientation check's index), `waivers` (pairs the orientation check refused),
 //! `locality` (the vertex order), `nth_key` (the batch bound), `replay` (the store as
 //! the engine's oracle).
@@ -47,18 +48,19 @@ mod pair_set;
 mod pass_blocks;
 mod pass_exact;
 mod placement;
+mod relaxation;
 mod replay;
 mod report;
 mod settings;
 mod waivers;
 
-pub use ladder::{Constraint, Relaxation, RelaxationStep};
 pub use observer::{Contraction, NoObserver, Observer, Progress};
 pub use options::{
     BoundaryMode, ContractionOrder, Length, PlacementMode, QuadricMode, SimplifyOptions, Target,
     VirtualPairs, Weighting, DEFAULT_BOUNDARY_WEIGHT, DEFAULT_MAX_NORMAL_ANGLE,
     DEFAULT_MIN_TRIANGLE_QUALITY, DEFAULT_WEIGHTING_MIX,
 };
+pub use relaxation::{Constraint, Relaxation, RelaxationStep};
 pub use replay::StoreReplay;
 pub use report::{Refusals, Simplified, SimplifyError, SimplifyReport, StopReason, Timings};
 

@@ -1,6 +1,6 @@
 //! What a run did ([`SimplifyReport`]), why it stopped, and why it could not run.
 
-use super::ladder::{Constraint, Relaxation};
+use super::relaxation::{Constraint, Relaxation};
 use crate::clean::CleanReport;
 use crate::{IndexedMesh, InputError};
 use std::fmt;

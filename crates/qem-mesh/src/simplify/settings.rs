@@ -1,8 +1,8 @@
 //! The one place where options become settings: what the engine reads, in the form
 //! it reads it (normalised units, cosines, flags).
 
-use super::ladder::RelaxationStep;
 use super::options::{BoundaryMode, PlacementMode, SimplifyOptions};
+use super::relaxation::RelaxationStep;
 use crate::clean::min_double_area;
 use qem_core::Frame;
 
