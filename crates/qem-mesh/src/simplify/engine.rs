@@ -49,6 +49,16 @@ use rayon::prelude::*;
 use smallvec::SmallVec;
 use std::cmp::Ordering;
 
+/// A pair's cost as the orders rank it: a NaN cost (only from overflow) as +∞, so
+/// that it comes last.
+pub(super) fn ranked(cost: f64) -> f64 {
+    if cost.is_nan() {
+        f64::INFINITY
+    } else {
+        cost
+    }
+}
+
 /// How often (in attempted contractions) the observer's progress is called.
 const OBSERVER_INTERVAL: usize = 4096;
 
@@ -603,14 +613,7 @@ impl Engine {
         candidates.par_iter_mut().for_each(|c| {
             c.cost = match this.last_cost(c.a, c.b) {
                 Some(cost) => cost,
-                None => {
-                    let (placed, _) = this.place(c.a, c.b);
-                    if placed.cost.is_nan() {
-                        f64::INFINITY
-                    } else {
-                        placed.cost
-                    }
-                }
+                None => ranked(this.place(c.a, c.b).0.cost),
             };
         });
         self.candidates = candidates;

@@ -94,13 +94,7 @@ impl Engine {
                 if [a, b] == GONE {
                     continue;
                 }
-                let (placed, _) = self.place(a, b);
-                let cost = if placed.cost.is_nan() {
-                    f64::INFINITY
-                } else {
-                    placed.cost
-                };
-                greedy.queue.push(id, cost);
+                greedy.queue.push(id, ranked(self.place(a, b).0.cost));
             }
         }
         self.greedy = greedy;
@@ -159,13 +153,9 @@ impl Engine {
             if let Some(&(_, q_ab)) = shared.get(slot[other as usize] as usize) {
                 q -= q_ab;
             }
-            let (placed, _) = self.place_with(a, b, q);
-            let cost = if placed.cost.is_nan() {
-                f64::INFINITY
-            } else {
-                placed.cost
-            };
-            greedy.queue.push(id, cost);
+            greedy
+                .queue
+                .push(id, ranked(self.place_with(a, b, q).0.cost));
         }
         for &(n, _) in greedy.shared.iter() {
             greedy.shared_slot[n as usize] = u32::MAX;
