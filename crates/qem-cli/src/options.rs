@@ -97,8 +97,9 @@ pub struct SimplifyFlags {
     pub preserve_topology: bool,
     /// Stop when no pair passes every check instead of relaxing them: without it, a
     /// run that gets stuck relaxes the fold-over rules, then the border-loop rule, then
-    /// lets edge contractions merge faces, each only when the stricter rules have
-    /// nothing left (the report's `relaxations`); what you asked for (--preserve-topology,
+    /// lets edge contractions merge faces, then lets faces turn away from their input
+    /// faces, each only when the stricter rules have nothing left (the report's
+    /// `relaxations`); what you asked for (--preserve-topology,
     /// --lock, --lock-boundary, --max-error) is never relaxed [default: off].
     #[arg(long)]
     pub strict: bool,

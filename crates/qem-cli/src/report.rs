@@ -134,17 +134,7 @@ impl SimplifyJson {
             stop_reason: r.stop_reason.as_str(),
             cleanup,
             degenerate_faces_removed: r.degenerate_faces_removed,
-            rejected: BTreeMap::from([
-                ("degenerate", r.rejected.degenerate),
-                ("flip", r.rejected.flip),
-                ("sliver", r.rejected.sliver),
-                ("topology", r.rejected.topology),
-                ("locked", r.rejected.locked),
-                ("border", r.rejected.border),
-                ("merge", r.rejected.merge),
-                ("orientation", r.rejected.orientation),
-                ("last_triangles", r.rejected.last_triangles),
-            ]),
+            rejected: BTreeMap::from(r.rejected.named()),
             relaxations: r
                 .relaxations
                 .iter()

@@ -683,15 +683,9 @@ fn report_dict<'py>(
     d.set_item("cleanup", cleanup)?;
     d.set_item("degenerate_faces_removed", r.degenerate_faces_removed)?;
     let rejected = PyDict::new(py);
-    rejected.set_item("degenerate", r.rejected.degenerate)?;
-    rejected.set_item("flip", r.rejected.flip)?;
-    rejected.set_item("sliver", r.rejected.sliver)?;
-    rejected.set_item("topology", r.rejected.topology)?;
-    rejected.set_item("locked", r.rejected.locked)?;
-    rejected.set_item("border", r.rejected.border)?;
-    rejected.set_item("merge", r.rejected.merge)?;
-    rejected.set_item("orientation", r.rejected.orientation)?;
-    rejected.set_item("last_triangles", r.rejected.last_triangles)?;
+    for (name, count) in r.rejected.named() {
+        rejected.set_item(name, count)?;
+    }
     d.set_item("rejected", rejected)?;
     let relaxations = PyList::empty(py);
     for x in &r.relaxations {

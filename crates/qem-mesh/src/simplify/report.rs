@@ -235,6 +235,22 @@ impl Refusals {
             + last_triangles
     }
 
+    /// Every count with its snake_case name, as used in JSON reports (the CLI's and
+    /// the Python package's `rejected`).
+    pub fn named(&self) -> [(&'static str, usize); 9] {
+        [
+            ("degenerate", self.degenerate),
+            ("flip", self.flip),
+            ("sliver", self.sliver),
+            ("topology", self.topology),
+            ("locked", self.locked),
+            ("border", self.border),
+            ("merge", self.merge),
+            ("orientation", self.orientation),
+            ("last_triangles", self.last_triangles),
+        ]
+    }
+
     /// Adds `other`'s counts to these.
     pub(crate) fn add(&mut self, other: &Refusals) {
         self.degenerate += other.degenerate;
