@@ -11,9 +11,10 @@
 //!   optimal placement, area weighting) and `Target::Triangles(target)`. The timed call
 //!   is the whole library call: validation, cleaning, the working mesh and its quadrics,
 //!   the loop, compaction.
-//!   With `--fast`, `SimplifyOptions::FAST` instead (the pass-based order, summed
-//!   quadrics, no orientation check), reported as `qem --fast`; `--orientation-check`
-//!   and `--exact` (with `--fast`) turn on the orientation check and exact quadrics.
+//!   With `--fast`, `SimplifyOptions::FAST` instead (summed quadrics, no orientation
+//!   check, the solve's point), reported as `qem --fast`; `--orientation-check` and
+//!   `--exact` (with `--fast`) turn on the orientation check and exact quadrics.
+//!   `--passes` runs the defaults in the pass-based order (`qem --order passes`).
 //! - meshopt: `meshopt::simplify` (meshoptimizer's `meshopt_simplify`, vendored by the
 //!   `meshopt` crate) on `f32` positions, with the target index count, no options and
 //!   a target error of `f32::MAX`, so that it stops on the count alone. Only the call is
@@ -47,7 +48,7 @@
 //! mesh, the two phases before the quadrics, apart.
 
 use qem_mesh::clean::{clean, CleanOptions};
-use qem_mesh::simplify::{simplify, QuadricMode, SimplifyOptions, Target};
+use qem_mesh::simplify::{simplify, ContractionOrder, QuadricMode, SimplifyOptions, Target};
 use qem_mesh::{IndexedMesh, MeshStore};
 use std::collections::HashMap;
 use std::path::PathBuf;
@@ -89,10 +90,14 @@ struct Args {
     orientation_check: bool,
     /// With `fast`, exact quadrics.
     exact: bool,
+    /// The defaults in `ContractionOrder::Passes` (not with `fast`).
+    passes: bool,
+    /// qem's vertex clustering against `meshopt::simplify_sloppy`.
+    cluster: bool,
 }
 
 const USAGE: &str = "usage: versus [--input dragon|soup|sphere:N|PATH]... [--ratios R,R...] \
-                     [--runs K] [--tool both|qem|meshopt|none|prep] [--fast [--orientation-check] [--exact]]";
+                     [--runs K] [--tool both|qem|meshopt|none|prep] [--fast [--orientation-check] [--exact] | --passes | --cluster]";
 
 fn parse_args() -> Result<Args, String> {
     let mut args = Args {
@@ -103,6 +108,8 @@ fn parse_args() -> Result<Args, String> {
         fast: false,
         orientation_check: false,
         exact: false,
+        passes: false,
+        cluster: false,
     };
     let mut it = std::env::args().skip(1);
     while let Some(flag) = it.next() {
@@ -140,6 +147,8 @@ fn parse_args() -> Result<Args, String> {
             "--fast" => args.fast = true,
             "--orientation-check" => args.orientation_check = true,
             "--exact" => args.exact = true,
+            "--passes" => args.passes = true,
+            "--cluster" => args.cluster = true,
             "-h" | "--help" => return Err(USAGE.to_string()),
             other => return Err(format!("unknown argument {other:?}\n{USAGE}")),
         }
@@ -147,6 +156,16 @@ fn parse_args() -> Result<Args, String> {
     if (args.orientation_check || args.exact) && !args.fast {
         return Err(format!(
             "--orientation-check and --exact need --fast\n{USAGE}"
+        ));
+    }
+    if [args.passes, args.fast, args.cluster]
+        .iter()
+        .filter(|&&x| x)
+        .count()
+        > 1
+    {
+        return Err(format!(
+            "--passes, --fast and --cluster exclude each other\n{USAGE}"
         ));
     }
     if args.inputs.is_empty() {
@@ -350,6 +369,8 @@ fn qem_options(args: &Args, target: usize) -> SimplifyOptions {
             } else {
                 QuadricMode::Sum
             })
+    } else if args.passes {
+        SimplifyOptions::DEFAULT.with_order(ContractionOrder::Passes)
     } else {
         SimplifyOptions::DEFAULT
     };
@@ -361,8 +382,26 @@ fn qem_options(args: &Args, target: usize) -> SimplifyOptions {
 fn qem_once(
     mesh: &IndexedMesh,
     options: &SimplifyOptions,
+    cluster: bool,
     run: usize,
 ) -> Result<(usize, f64, Option<f64>), String> {
+    if cluster {
+        let target = match options.target {
+            Target::Triangles(n) => n,
+            _ => unreachable!("the bench always asks for a count"),
+        };
+        let (out, wall, cpu) = timed(|| qem_mesh::cluster::cluster(mesh, target));
+        let out = out.map_err(|e| format!("qem: {e}"))?;
+        eprintln!(
+            "  qem run {run}: search {:.3} s ({} grids), build {:.3} s",
+            out.report.search.as_secs_f64(),
+            out.report.grids_counted,
+            out.report.build.as_secs_f64()
+        );
+        let triangles_out = out.mesh.triangle_count();
+        std::hint::black_box(out);
+        return Ok((triangles_out, wall, cpu));
+    }
     let (out, wall, cpu) = timed(|| simplify(mesh, options));
     let out = out.map_err(|e| format!("qem: {e}"))?;
     let t = out.report.timings;
@@ -384,7 +423,15 @@ fn meshopt_once(
     adapter: &meshopt::VertexDataAdapter,
     indices: &[u32],
     target: usize,
+    sloppy: bool,
 ) -> (usize, f64, Option<f64>) {
+    if sloppy {
+        let (out, wall, cpu) =
+            timed(|| meshopt::simplify_sloppy(indices, adapter, target * 3, f32::MAX, None));
+        let triangles_out = out.len() / 3;
+        std::hint::black_box(out);
+        return (triangles_out, wall, cpu);
+    }
     let (out, wall, cpu) = timed(|| {
         meshopt::simplify(
             indices,
@@ -464,21 +511,28 @@ fn run() -> Result<(), String> {
             let (mut qem, mut meshopt) = (Samples::default(), Samples::default());
             for run in 0..args.runs {
                 if args.tools.qem() {
-                    qem.push(qem_once(&welded, &options, run)?);
+                    qem.push(qem_once(&welded, &options, args.cluster, run)?);
                 }
                 if args.tools.meshopt() {
-                    meshopt.push(meshopt_once(&adapter, &indices, target));
+                    meshopt.push(meshopt_once(&adapter, &indices, target, args.cluster));
                 }
             }
             let (qem, meshopt) = (qem.measured(), meshopt.measured());
             let qem_name = match (args.fast, args.orientation_check, args.exact) {
+                (false, ..) if args.cluster => "qem --cluster",
+                (false, ..) if args.passes => "qem --order passes",
                 (false, ..) => "qem",
                 (true, false, false) => "qem --fast",
                 (true, true, false) => "qem --fast --orientation-check",
                 (true, false, true) => "qem --fast --exact",
                 (true, true, true) => "qem --fast --exact --orientation-check",
             };
-            for (tool, m) in [(qem_name, &qem), ("meshopt", &meshopt)] {
+            let meshopt_name = if args.cluster {
+                "meshopt sloppy"
+            } else {
+                "meshopt"
+            };
+            for (tool, m) in [(qem_name, &qem), (meshopt_name, &meshopt)] {
                 let Some(m) = m else { continue };
                 let (versus, versus_cpu) = match (tool, &meshopt) {
                     (name, Some(o)) if name == qem_name => (

@@ -86,7 +86,10 @@ fn decode(data: &[u8]) -> (IndexedMesh, SimplifyOptions, Option<PassesExtra>) {
         .with_drop_zero_area(!flag(5))
         .with_drop_duplicates(!flag(6))
         .with_weld_tolerance(flag(7).then_some(tolerance * scale));
+    // Greedy unless the seed says passes (the seeds from before the pass-based order
+    // were greedy runs, the default then).
     let mut options = SimplifyOptions::DEFAULT
+        .with_order(ContractionOrder::Greedy)
         .with_target(target)
         .with_placement(if flag(0) {
             PlacementMode::EndpointOrMidpoint

@@ -5,10 +5,12 @@
 //! - [`MeshStore`]: the non-manifold adjacency store that contractions mutate.
 //! - [`pairs`]: virtual pairs (close vertices that share no edge) from a uniform grid.
 //! - [`simplify`]: the Garland–Heckbert contraction loop, its options and report.
+//! - [`cluster`]: vertex clustering on a grid (fast, any input, topology not kept).
 //! - `io` (feature `io`): readers and writers for OBJ, PLY, STL and OFF, with `.gz`.
 #![forbid(unsafe_code)]
 
 pub mod clean;
+pub mod cluster;
 pub mod input;
 pub mod inspect;
 #[cfg(feature = "io")]

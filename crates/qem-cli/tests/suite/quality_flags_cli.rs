@@ -211,3 +211,51 @@ fn strict_and_the_ladder_show_in_the_report() {
     assert_eq!(j["relaxations"].as_array().map(Vec::len), Some(0));
     assert!(line.contains("(no_valid_pair: strict)"), "{line}");
 }
+
+/// `--cluster` clusters (the report says no contraction was made, the count is near
+/// the target and the output is a valid mesh), `--order` picks the order, and the
+/// contraction-only flags are usage errors with `--cluster`.
+#[test]
+fn cluster_and_order_flags() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let (out, report) = (dir.path().join("out.obj"), dir.path().join("r.json"));
+    let input = spot();
+    let run = |extra: &[&str]| {
+        let mut args = vec!["simplify", s(&input), "-o", s(&out), "--ratio", "0.1"];
+        args.extend_from_slice(&["--report", s(&report), "-q"]);
+        args.extend_from_slice(extra);
+        qem(&args)
+    };
+    let o = run(&["--cluster"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let j = common::json(&report);
+    assert_eq!(j["edge_contractions"], 0);
+    let (got, target) = (
+        j["triangles_out"].as_u64().expect("a count"),
+        j["target_triangles"].as_u64().expect("a count"),
+    );
+    assert!(got.abs_diff(target) * 20 <= target, "{got} for {target}");
+    let mesh = read_path(&out).expect("the output reads back").mesh;
+    assert_eq!(mesh.triangle_count() as u64, got);
+    assert!(mesh.validate().is_ok());
+
+    for flag in [
+        "--preserve-topology",
+        "--fast",
+        "--lock-boundary",
+        "--strict",
+    ] {
+        let o = run(&["--cluster", flag]);
+        assert_eq!(o.status.code(), Some(2), "{flag}: {}", stderr(&o));
+    }
+    let o = run(&["--cluster", "--max-error", "0.01"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+
+    for order in ["greedy", "passes"] {
+        let o = run(&["--order", order]);
+        assert!(o.status.success(), "{order}: {}", stderr(&o));
+        assert_eq!(common::json(&report)["stop_reason"], "target_reached");
+    }
+    let o = run(&["--order", "sideways"]);
+    assert_eq!(o.status.code(), Some(2));
+}

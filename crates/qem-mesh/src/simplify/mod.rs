@@ -56,8 +56,8 @@ mod waivers;
 
 pub use observer::{Contraction, NoObserver, Observer, Progress};
 pub use options::{
-    BoundaryMode, ContractionOrder, Length, PlacementMode, QuadricMode, SimplifyOptions, Target,
-    VirtualPairs, Weighting, DEFAULT_BOUNDARY_WEIGHT, DEFAULT_MAX_NORMAL_ANGLE,
+    BoundaryMode, ContractionOrder, Length, Method, PlacementMode, QuadricMode, SimplifyOptions,
+    Target, VirtualPairs, Weighting, DEFAULT_BOUNDARY_WEIGHT, DEFAULT_MAX_NORMAL_ANGLE,
     DEFAULT_MIN_TRIANGLE_QUALITY, DEFAULT_WEIGHTING_MIX,
 };
 pub use relaxation::{Constraint, Relaxation, RelaxationStep};
@@ -151,6 +151,9 @@ pub fn simplify_levels(
     levels: &[Target],
     observer: &mut dyn Observer,
 ) -> Result<Vec<Simplified>, SimplifyError> {
+    if options.method == Method::Clustering {
+        return cluster_levels(mesh, options, levels);
+    }
     let mut timings = Timings::default();
     let clock = Instant::now();
     mesh.validate()?;
@@ -264,6 +267,75 @@ pub fn simplify_levels(
             timings,
         };
         results.push(Simplified { mesh: out, report });
+    }
+    Ok(results)
+}
+
+/// [`simplify_levels`] with [`Method::Clustering`]: each level clustered from the
+/// input, reported in the engine's terms (no contraction, no cleaning pass; the
+/// setup's time is the grid's search, the loop's the clustering itself).
+fn cluster_levels(
+    mesh: &IndexedMesh,
+    options: &SimplifyOptions,
+    levels: &[Target],
+) -> Result<Vec<Simplified>, SimplifyError> {
+    let refused = if options.preserve_topology {
+        Some("preserve_topology")
+    } else if !options.locked_vertices.is_empty() {
+        Some("locked_vertices")
+    } else if options.boundary == BoundaryMode::Locked {
+        Some("boundary: Locked")
+    } else if options.max_error.is_some() {
+        Some("max_error")
+    } else if levels.contains(&Target::None) {
+        Some("target: None")
+    } else {
+        None
+    };
+    if let Some(option) = refused {
+        return Err(SimplifyError::NotWithClustering { option });
+    }
+    let mut results = Vec::with_capacity(levels.len());
+    for &level in levels {
+        let target_triangles = target_count(level, mesh.triangle_count());
+        let clustered = crate::cluster::cluster(mesh, target_triangles)?;
+        let r = clustered.report;
+        if clustered.mesh.triangles.is_empty() {
+            return Err(SimplifyError::NothingLeftAfterCleaning {
+                triangles_in: mesh.triangle_count(),
+            });
+        }
+        let report = SimplifyReport {
+            triangles_in: r.triangles_in,
+            vertices_in: r.vertices_in,
+            triangles_out: r.triangles_out,
+            vertices_out: r.vertices_out,
+            target_triangles,
+            edge_contractions: 0,
+            virtual_contractions: 0,
+            virtual_pairs: 0,
+            virtual_pairs_capped: 0,
+            max_error: r.max_error,
+            max_error_abs: r.max_error_abs,
+            bbox_diagonal: r.bbox_diagonal,
+            stop_reason: StopReason::TargetReached,
+            cleanup: crate::clean::CleanReport::default(),
+            degenerate_faces_removed: 0,
+            rejected: Refusals::default(),
+            relaxations: Vec::new(),
+            stopped_by: None,
+            locked_vertices: 0,
+            faces_flipped: 0,
+            timings: Timings {
+                setup: r.search,
+                contract: r.build,
+                ..Timings::default()
+            },
+        };
+        results.push(Simplified {
+            mesh: clustered.mesh,
+            report,
+        });
     }
     Ok(results)
 }

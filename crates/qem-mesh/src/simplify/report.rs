@@ -140,6 +140,13 @@ pub enum SimplifyError {
         /// How many vertices the input has.
         vertex_count: usize,
     },
+    /// [`Method::Clustering`](super::Method::Clustering) was asked together with an
+    /// option it cannot honour.
+    NotWithClustering {
+        /// The option, as the library names it (`preserve_topology`,
+        /// `locked_vertices`, `boundary: Locked`, `max_error`, `target: None`).
+        option: &'static str,
+    },
 }
 
 impl fmt::Display for SimplifyError {
@@ -158,6 +165,11 @@ impl fmt::Display for SimplifyError {
                 f,
                 "locked vertex {index} is out of range: the input has {vertex_count} \
                  vertices (indices start at 0)"
+            ),
+            SimplifyError::NotWithClustering { option } => write!(
+                f,
+                "vertex clustering cannot honour {option}: it places one vertex per grid \
+                 cell and reaches a triangle count, nothing else"
             ),
         }
     }

@@ -10,6 +10,7 @@ mod common;
 mod passes_common;
 
 mod bvh_extremes;
+mod cluster;
 mod exact_quadrics;
 #[cfg(feature = "io")]
 mod io_corpus;
