@@ -435,26 +435,7 @@ impl SimplifyOptions {
     /// assert!(out.mesh.triangle_count().abs_diff(200) <= 10);
     /// # Ok::<(), qem_mesh::simplify::SimplifyError>(())
     /// ```
-    pub const CLUSTER: SimplifyOptions = SimplifyOptions {
-        target: Target::Ratio(0.5),
-        max_error: None,
-        pair_threshold: Length::DiagonalFraction(0.0),
-        max_virtual_pairs_per_vertex: 8,
-        virtual_pairs: VirtualPairs::Any,
-        placement: PlacementMode::Optimal,
-        weighting: Weighting::Mixed(DEFAULT_WEIGHTING_MIX),
-        quadrics: QuadricMode::Exact,
-        boundary: BoundaryMode::Planes(DEFAULT_BOUNDARY_WEIGHT),
-        max_normal_angle: DEFAULT_MAX_NORMAL_ANGLE,
-        min_triangle_quality: DEFAULT_MIN_TRIANGLE_QUALITY,
-        orientation_check: true,
-        preserve_topology: false,
-        locked_vertices: Vec::new(),
-        clean: CleanOptions::DEFAULT,
-        order: ContractionOrder::Greedy,
-        strict: false,
-        method: Method::Clustering,
-    };
+    pub const CLUSTER: SimplifyOptions = SimplifyOptions::DEFAULT.with_method(Method::Clustering);
 
     /// Sets [`target`](Self::target).
     pub fn with_target(mut self, target: Target) -> Self {
@@ -558,8 +539,9 @@ impl SimplifyOptions {
         self
     }
 
-    /// Sets [`method`](Self::method).
-    pub fn with_method(mut self, method: Method) -> Self {
+    /// Sets [`method`](Self::method). (A `const fn`, so that
+    /// [`CLUSTER`](Self::CLUSTER) is spelled from [`DEFAULT`](Self::DEFAULT).)
+    pub const fn with_method(mut self, method: Method) -> Self {
         self.method = method;
         self
     }
