@@ -24,7 +24,7 @@ use pyo3::types::{PyBool, PyDict, PyList, PyString};
 use qem_mesh::clean::CleanOptions;
 use qem_mesh::measure::{MeasureOptions, Measurement};
 use qem_mesh::simplify::{
-    BoundaryMode, ContractionOrder, Length, Observer, PlacementMode, Progress, QuadricMode,
+    BoundaryMode, ContractionOrder, Length, Method, Observer, PlacementMode, Progress, QuadricMode,
     SimplifyOptions, SimplifyReport, Target, VirtualPairs, Weighting,
 };
 use qem_mesh::IndexedMesh;
@@ -362,6 +362,7 @@ const OPTION_NAMES: &[&str] = &[
     "clean",
     "order",
     "strict",
+    "method",
 ];
 
 /// The keys of the `clean` option, the fields of [`CleanOptions`].
@@ -531,6 +532,10 @@ fn simplify_options(options: Option<&Bound<'_, PyDict>>) -> PyResult<SimplifyOpt
             "orientation_check" => o.with_orientation_check(boolean("orientation_check", v)?),
             "preserve_topology" => o.with_preserve_topology(boolean("preserve_topology", v)?),
             "strict" => o.with_strict(boolean("strict", v)?),
+            "method" => o.with_method(match choice("method", v, &["contraction", "clustering"])? {
+                "contraction" => Method::Contraction,
+                _ => Method::Clustering,
+            }),
             "locked_vertices" => o.with_locked_vertices(locked_vertices(v)?),
             "clean" => o.with_clean(clean_options(v)?),
             "order" => o.with_order(match choice("order", v, &["greedy", "passes"])? {
@@ -640,6 +645,13 @@ fn options_dict<'py>(py: Python<'py>, o: &SimplifyOptions) -> PyResult<Bound<'py
         match o.order {
             ContractionOrder::Greedy => "greedy",
             ContractionOrder::Passes => "passes",
+        },
+    )?;
+    d.set_item(
+        "method",
+        match o.method {
+            Method::Contraction => "contraction",
+            Method::Clustering => "clustering",
         },
     )?;
     Ok(d)
@@ -791,7 +803,7 @@ impl Observer for PyObserver {
 /// (start from SimplifyOptions::FAST), max_error, absolute, pair_threshold,
 /// max_virtual_pairs_per_vertex, virtual_pairs, placement, weighting, quadrics,
 /// boundary, max_normal_angle, min_triangle_quality, orientation_check,
-/// preserve_topology, locked_vertices, clean, order, strict. The
+/// preserve_topology, locked_vertices, clean, order, strict, method. The
 /// stub file (qem/__init__.pyi) documents each.
 ///
 /// progress: called as progress(fraction) every few thousand contractions, fraction in

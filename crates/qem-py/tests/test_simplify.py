@@ -110,6 +110,22 @@ def test_default_options_are_the_libraries():
     assert f["orientation_check"] is False and f["placement"] == "solve_first"
 
 
+def test_clustering_reaches_the_count_and_refuses_what_it_cannot_honour(sphere):
+    v, f = sphere
+    target = len(f) // 10
+    cv, cf, report = qem.simplify(v, f, triangles=target, method="clustering")
+    assert abs(len(cf) - target) <= 0.05 * target, (len(cf), target)
+    assert report["edge_contractions"] == 0 and report["triangles_out"] == len(cf)
+    assert_valid(cv, cf)
+    again = qem.simplify(v, f, triangles=target, method="clustering")
+    assert np.array_equal(cv, again[0]) and np.array_equal(cf, again[1])
+    with pytest.raises(qem.QemError, match="preserve_topology"):
+        qem.simplify(v, f, triangles=target, method="clustering", preserve_topology=True)
+    with pytest.raises(ValueError):
+        qem.simplify(v, f, method="grid")
+    assert qem.default_options()["method"] == "contraction"
+
+
 def test_stub_defaults_match_the_library():
     # The stub writes each default out for readers; they must be the library's.
     import ast

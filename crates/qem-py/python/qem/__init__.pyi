@@ -129,6 +129,7 @@ def simplify(
     clean: CleanOptions | None = None,
     order: Literal["greedy", "passes"] = "greedy",
     strict: bool = False,
+    method: Literal["contraction", "clustering"] = "contraction",
 ) -> Tuple[Vertices, Faces, Report]:
     """Simplifies a triangle mesh by Garland-Heckbert pair contraction.
 
@@ -188,6 +189,11 @@ def simplify(
       with stop_reason ``"no_valid_pair"``). Options you set yourself
       (``preserve_topology``, ``locked_vertices``, ``boundary="locked"``,
       ``max_error``) are never relaxed.
+    - ``method``: ``"contraction"`` (pair contraction, what every option above
+      describes) or ``"clustering"`` (vertex clustering on a grid, ``qem simplify
+      --cluster``: many times faster, near the count on any input, no topology kept;
+      only the target applies, and ``preserve_topology``, ``locked_vertices``,
+      ``boundary="locked"`` and ``max_error`` are refused with QemError).
 
     Raises QemError (a ValueError) when the input or the options are refused, with
     qem's message; TypeError for an argument of the wrong kind or an unknown option.
