@@ -14,7 +14,10 @@
 //!   With `--fast`, `SimplifyOptions::FAST` instead (summed quadrics, no orientation
 //!   check, the solve's point), reported as `qem --fast`; `--orientation-check` and
 //!   `--exact` (with `--fast`) turn on the orientation check and exact quadrics.
-//!   `--passes` runs the defaults in the pass-based order (`qem --order passes`).
+//!   `--passes` runs the defaults in the pass-based order (`qem --order passes`);
+//!   `--cluster` runs `SimplifyOptions::CLUSTER` (vertex clustering; its phases print
+//!   as setup = the grid's search, contract = the clustering) against
+//!   `meshopt::simplify_sloppy`, reported as `meshopt sloppy`.
 //! - meshopt: `meshopt::simplify` (meshoptimizer's `meshopt_simplify`, vendored by the
 //!   `meshopt` crate) on `f32` positions, with the target index count, no options and
 //!   a target error of `f32::MAX`, so that it stops on the count alone. Only the call is
@@ -369,6 +372,8 @@ fn qem_options(args: &Args, target: usize) -> SimplifyOptions {
             } else {
                 QuadricMode::Sum
             })
+    } else if args.cluster {
+        SimplifyOptions::CLUSTER
     } else if args.passes {
         SimplifyOptions::DEFAULT.with_order(ContractionOrder::Passes)
     } else {
@@ -382,26 +387,8 @@ fn qem_options(args: &Args, target: usize) -> SimplifyOptions {
 fn qem_once(
     mesh: &IndexedMesh,
     options: &SimplifyOptions,
-    cluster: bool,
     run: usize,
 ) -> Result<(usize, f64, Option<f64>), String> {
-    if cluster {
-        let target = match options.target {
-            Target::Triangles(n) => n,
-            _ => unreachable!("the bench always asks for a count"),
-        };
-        let (out, wall, cpu) = timed(|| qem_mesh::cluster::cluster(mesh, target));
-        let out = out.map_err(|e| format!("qem: {e}"))?;
-        eprintln!(
-            "  qem run {run}: search {:.3} s ({} grids), build {:.3} s",
-            out.report.search.as_secs_f64(),
-            out.report.grids_counted,
-            out.report.build.as_secs_f64()
-        );
-        let triangles_out = out.mesh.triangle_count();
-        std::hint::black_box(out);
-        return Ok((triangles_out, wall, cpu));
-    }
     let (out, wall, cpu) = timed(|| simplify(mesh, options));
     let out = out.map_err(|e| format!("qem: {e}"))?;
     let t = out.report.timings;
@@ -511,7 +498,7 @@ fn run() -> Result<(), String> {
             let (mut qem, mut meshopt) = (Samples::default(), Samples::default());
             for run in 0..args.runs {
                 if args.tools.qem() {
-                    qem.push(qem_once(&welded, &options, args.cluster, run)?);
+                    qem.push(qem_once(&welded, &options, run)?);
                 }
                 if args.tools.meshopt() {
                     meshopt.push(meshopt_once(&adapter, &indices, target, args.cluster));

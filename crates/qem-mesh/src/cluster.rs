@@ -17,9 +17,11 @@
 //! may collapse) and of the contraction engine's accuracy.
 //!
 //! Deterministic: the cells, the search and the output order depend only on the input;
-//! the parallel steps are integer counts, and every floating-point sum runs in input
-//! order on one core.
+//! the parallel counts are integers, and the floating-point sums run in pieces fixed
+//! by the input, added in piece order (see `cell_quadrics`), so the bits are the same
+//! on any number of threads.
 
+use crate::clean::{clean, CleanOptions};
 use crate::input::{IndexedMesh, InputError};
 use qem_core::{minimize_by_cofactors, DVec3, Frame, Quadric};
 use rayon::prelude::*;
@@ -91,10 +93,9 @@ pub struct ClusterReport {
 /// triangles or more (`tests/suite/cluster.rs`), closer on large meshes; a count the
 /// grid cannot give (fewer triangles than the coarsest grid keeps, or a step between
 /// neighbouring grids on a regular mesh) is approached as closely as the grids tried
-/// allow. The output has no repeated-index face and no duplicate face (two faces
-/// on the same three vertices); unlike the contraction engine's output it may have
-/// faces of zero area where three cells' vertices are collinear, and non-manifold
-/// edges.
+/// allow. The output passes the same final cleaning as the contraction engine's
+/// (no repeated-index, zero-area or duplicate face, no unreferenced vertex, as
+/// [`CleanOptions::OUTPUT`] drops them); unlike it, it may have non-manifold edges.
 ///
 /// ```
 /// use qem_mesh::cluster::cluster;
@@ -242,11 +243,17 @@ fn cell_of(q: [u32; 3], grid: Grid) -> u64 {
     c[0] | (c[1] << CELL_BITS) | (c[2] << (2 * CELL_BITS))
 }
 
+/// Whether a triangle's corners fall in three different cells (it survives).
+#[inline]
+fn three_cells(c: [u64; 3]) -> bool {
+    c[0] != c[1] && c[1] != c[2] && c[0] != c[2]
+}
+
 /// The triangle's three cells, when they are three different ones.
 #[inline]
 fn surviving(t: [u32; 3], quantised: &[[u32; 3]], grid: Grid) -> Option<[u64; 3]> {
     let c = t.map(|v| cell_of(quantised[v as usize], grid));
-    (c[0] != c[1] && c[1] != c[2] && c[0] != c[2]).then_some(c)
+    three_cells(c).then_some(c)
 }
 
 /// The triple of cells as a key that does not depend on the corners' order.
@@ -256,14 +263,9 @@ fn unordered(mut c: [u64; 3]) -> [u64; 3] {
     c
 }
 
-/// How many triangles survive a grid (three different cells), before duplicates are
-/// merged: one read of every triangle, on all cores.
-fn raw_count(mesh: &IndexedMesh, quantised: &[[u32; 3]], grid: Grid) -> usize {
-    raw_count_of(&mesh.triangles, quantised, grid)
-}
-
-/// [`raw_count`] of some triangles.
-fn raw_count_of(triangles: &[[u32; 3]], quantised: &[[u32; 3]], grid: Grid) -> usize {
+/// How many of `triangles` survive a grid (three different cells), before duplicates
+/// are merged: one read of each triangle, on all cores.
+fn raw_count(triangles: &[[u32; 3]], quantised: &[[u32; 3]], grid: Grid) -> usize {
     triangles
         .par_iter()
         .filter(|&&t| surviving(t, quantised, grid).is_some())
@@ -307,40 +309,24 @@ fn off(count: usize, goal: f64) -> f64 {
 fn choose_grid(mesh: &IndexedMesh, quantised: &[[u32; 3]], target: usize) -> (Grid, usize) {
     let goal = target.max(1) as f64;
     let mut counted = 0;
-    let mut guess = ((goal / 2.0).sqrt() * ONE_CELL as f64) as Resolution;
-    // On a large mesh, a first search on every SAMPLE_STRIDE-th triangle (its count
-    // times the stride): a few counts at a fraction of the cost bring the guess close.
-    let sampled = mesh.triangle_count() >= SAMPLE_STRIDE * SAMPLE_STRIDE * 1024;
-    if sampled {
+    let first_guess = ((goal / 2.0).sqrt() * ONE_CELL as f64) as Resolution;
+    // On a large mesh every SAMPLE_STRIDE-th triangle (its count times the stride):
+    // a few counts at a fraction of the cost bring the guess close.
+    let (raw, _) = if mesh.triangle_count() >= SAMPLE_STRIDE * SAMPLE_STRIDE * 1024 {
         let sample: Vec<[u32; 3]> = mesh
             .triangles
             .iter()
             .step_by(SAMPLE_STRIDE)
             .copied()
             .collect();
-        guess = search(
-            |r| SAMPLE_STRIDE * raw_count_of(&sample, quantised, Grid::of(r)),
-            guess,
-            goal,
-            &mut counted,
-        );
-    }
-    let raw = if sampled {
-        guess
+        let count = |r| SAMPLE_STRIDE * raw_count(&sample, quantised, Grid::of(r));
+        search(count, first_guess, goal, &mut counted)
     } else {
-        search(
-            |r| raw_count(mesh, quantised, Grid::of(r)),
-            guess,
-            goal,
-            &mut counted,
-        )
+        let count = |r| raw_count(&mesh.triangles, quantised, Grid::of(r));
+        search(count, first_guess, goal, &mut counted)
     };
-    let (resolution, mut count) = search_with_count(
-        |r| distinct_count(mesh, quantised, Grid::of(r)),
-        raw,
-        goal,
-        &mut counted,
-    );
+    let distinct = |r| distinct_count(mesh, quantised, Grid::of(r));
+    let (resolution, mut count) = search(distinct, raw, goal, &mut counted);
     // Still off: the count jumps between neighbouring resolutions (a coarse grid on a
     // small mesh); shifted grids of the same resolution give other counts.
     let mut grid = Grid::of(resolution);
@@ -369,31 +355,8 @@ const SAMPLE_STRIDE: usize = 8;
 /// could not get within [`COUNT_TOLERANCE`].
 const SHIFTS: u32 = 16;
 
-/// [`search`], also returning the best count.
-fn search_with_count(
-    count: impl Fn(Resolution) -> usize,
-    guess: Resolution,
-    goal: f64,
-    counted: &mut usize,
-) -> (Resolution, usize) {
-    let mut best = (guess, usize::MAX);
-    let r = search(
-        |r| {
-            let c = count(r);
-            if off(c, goal) < off(best.1, goal) || best.1 == usize::MAX {
-                best = (r, c);
-            }
-            c
-        },
-        guess,
-        goal,
-        counted,
-    );
-    debug_assert_eq!(r, best.0);
-    (r, best.1)
-}
-
-/// The resolution whose `count` is nearest `goal` among those tried, starting from
+/// The resolution whose `count` is nearest `goal` among those tried, and that count,
+/// starting from
 /// `guess`; `counted` grows by the grids counted. The search ends within
 /// [`COUNT_TOLERANCE`] of the goal, after [`MAX_GRIDS`] counts, or when the bracket
 /// closes.
@@ -404,11 +367,11 @@ fn search_with_count(
 /// resolutions known to give too few and too many; a guess that would not move, or
 /// would leave the bracket, bisects it instead.
 fn search(
-    mut count: impl FnMut(Resolution) -> usize,
+    count: impl Fn(Resolution) -> usize,
     guess: Resolution,
     goal: f64,
     counted: &mut usize,
-) -> Resolution {
+) -> (Resolution, usize) {
     let mut below = ONE_CELL; // known to give too few (or the coarsest grid)
     let mut above = FINEST + 1; // known to give too many (or past the finest)
     let mut guess = guess.clamp(ONE_CELL, FINEST);
@@ -462,7 +425,7 @@ fn search(
         }
         guess = next;
     }
-    best.map_or(ONE_CELL, |(r, _)| r)
+    best.expect("the loop counts at least one grid")
 }
 
 /// The output of the grid of `resolution`, and the largest RMS distance of a cell's
@@ -481,7 +444,7 @@ fn build(
         .into_par_iter()
         .filter_map(|i| {
             let c = mesh.triangles[i as usize].map(|v| cells[v as usize]);
-            (c[0] != c[1] && c[1] != c[2] && c[0] != c[2]).then_some((i, c))
+            three_cells(c).then_some((i, c))
         })
         .collect();
     let mut order: Vec<([u64; 3], u32)> = survivors
@@ -547,10 +510,14 @@ fn build(
         .collect();
     let max_error = placed.iter().map(|&(_, e)| e).fold(0.0, f64::max);
     let positions = placed.into_iter().map(|(p, _)| p).collect();
-    (
-        drop_zero_area(IndexedMesh::new(positions, triangles)),
-        max_error,
+    // Faces whose cell vertices came out (nearly) collinear, as the engine's own
+    // output cleaning drops them; no weld (vertices of different cells stay apart).
+    let out = clean(
+        &IndexedMesh::new(positions, triangles),
+        &CleanOptions::OUTPUT,
     )
+    .mesh;
+    (out, max_error)
 }
 
 /// No output vertex.
@@ -641,33 +608,3 @@ fn cell_means(
 /// weight: far too faint to move the vertex along a direction the planes fix, strong
 /// enough to settle the directions they leave free.
 const MEAN_PULL: f64 = 1e-6;
-
-/// `mesh` without its faces of zero area (three vertices on a line) and the vertices
-/// only they used, in the same order otherwise.
-fn drop_zero_area(mesh: IndexedMesh) -> IndexedMesh {
-    let p = |v: u32| DVec3::from_array(mesh.positions[v as usize]);
-    let kept: Vec<[u32; 3]> = mesh
-        .triangles
-        .iter()
-        .copied()
-        .filter(|t| (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0])) != DVec3::ZERO)
-        .collect();
-    if kept.len() == mesh.triangles.len() {
-        return mesh;
-    }
-    let mut number = vec![u32::MAX; mesh.vertex_count()];
-    let mut positions = Vec::new();
-    let triangles = kept
-        .iter()
-        .map(|t| {
-            t.map(|v| {
-                if number[v as usize] == u32::MAX {
-                    number[v as usize] = positions.len() as u32;
-                    positions.push(mesh.positions[v as usize]);
-                }
-                number[v as usize]
-            })
-        })
-        .collect();
-    IndexedMesh::new(positions, triangles)
-}

@@ -165,8 +165,8 @@ pub enum ContractionOrder {
     /// [`Greedy`](Self::Greedy) (BENCHMARKS.md, "Passes with every default option"):
     /// about 0.4 times the time; on the 9 clean corpus scans as accurate (mean error at
     /// most the best of five peers' in 23 of 27 cases against 22, Hausdorff distance in
-    /// 15 against 15, no face facing away at 0.1); on 40 messy corpus meshes a 7.5%
-    /// larger Hausdorff distance (geometric mean), and on ps_mk4_gantry at 0.01 a
+    /// 15 against 15, no face facing away at 0.1); on 40 messy corpus meshes a 6.6%
+    /// larger Hausdorff distance (geometric mean of 80 runs), and on ps_mk4_gantry at 0.01 a
     /// whole part lost (53% of the diagonal against 1.0%). A pair the orientation check
     /// refuses is ranked at the waivers' penalty in
     /// later passes and tried without the check next time, unless one of its ends moves
