@@ -227,6 +227,18 @@ pub fn clean(mesh: &IndexedMesh, options: &CleanOptions) -> Cleaned {
             }
         })
         .collect();
+    // The input number of each kept face, for the attributes (positions-only meshes
+    // need none and pay nothing).
+    let mut face_from: Option<Vec<u32>> = (!mesh.attributes.is_empty()).then(|| {
+        (0..faces.len() as u32)
+            .filter(|&t| {
+                !matches!(
+                    faces[t as usize],
+                    DROPPED_REPEATED_INDEX | DROPPED_ZERO_AREA
+                )
+            })
+            .collect()
+    });
     faces.retain(|f| match *f {
         DROPPED_REPEATED_INDEX => {
             report.repeated_index_faces += 1;
@@ -239,7 +251,7 @@ pub fn clean(mesh: &IndexedMesh, options: &CleanOptions) -> Cleaned {
         _ => true,
     });
     if options.drop_duplicates {
-        report.duplicate_faces = drop_duplicate_faces(&mut faces, n);
+        report.duplicate_faces = drop_duplicate_faces(&mut faces, face_from.as_mut(), n);
     }
 
     // Number the surviving vertices in input order.
@@ -270,8 +282,11 @@ pub fn clean(mesh: &IndexedMesh, options: &CleanOptions) -> Cleaned {
         .par_iter()
         .map(|f| f.map(|i| vertex_map[i as usize]))
         .collect();
+    let attributes = face_from
+        .map(|kept| mesh.attributes.for_faces(&kept))
+        .unwrap_or_default();
     Cleaned {
-        mesh: IndexedMesh::new(positions, triangles),
+        mesh: IndexedMesh::new(positions, triangles).with_attributes(attributes),
         report,
         vertex_map,
     }
@@ -392,7 +407,11 @@ fn weld_within(positions: &[[f64; 3]], tolerance: f64, representative: &mut [u32
 }
 
 /// Removes faces whose vertex set equals an earlier face's; returns how many.
-fn drop_duplicate_faces(faces: &mut Vec<[u32; 3]>, vertex_count: usize) -> usize {
+fn drop_duplicate_faces(
+    faces: &mut Vec<[u32; 3]>,
+    face_from: Option<&mut Vec<u32>>,
+    vertex_count: usize,
+) -> usize {
     let sets: Vec<([u32; 3], u32)> = faces
         .par_iter()
         .enumerate()
@@ -412,6 +431,13 @@ fn drop_duplicate_faces(faces: &mut Vec<[u32; 3]>, vertex_count: usize) -> usize
         k += 1;
         keep[k - 1]
     });
+    if let Some(from) = face_from {
+        let mut k = 0;
+        from.retain(|_| {
+            k += 1;
+            keep[k - 1]
+        });
+    }
     before - faces.len()
 }
 

@@ -5,6 +5,7 @@
 //! untrusted data and the algorithm: after it succeeds every coordinate is finite and
 //! every index is in range, so later stages never have to check again.
 
+use crate::attributes::{AttributeError, Attributes};
 use std::fmt;
 
 /// The largest number of vertices or triangles qem accepts by default.
@@ -35,6 +36,10 @@ pub struct IndexedMesh {
     pub positions: Vec<[f64; 3]>,
     /// Triangles as three indices into `positions`, counter-clockwise seen from outside.
     pub triangles: Vec<[u32; 3]>,
+    /// Texture coordinates, normals, colours and other channels per triangle corner,
+    /// materials and groups per triangle (see [`crate::attributes`]); empty for a
+    /// positions-only mesh.
+    pub attributes: Attributes,
 }
 
 /// Why an [`IndexedMesh`] was refused, and where.
@@ -66,6 +71,8 @@ pub enum InputError {
         /// The limit.
         limit: usize,
     },
+    /// The attributes are malformed (see [`AttributeError`]).
+    Attributes(AttributeError),
 }
 
 impl fmt::Display for InputError {
@@ -86,6 +93,7 @@ impl fmt::Display for InputError {
             InputError::TooLarge { what, count, limit } => {
                 write!(f, "{count} {what} is more than the limit of {limit}")
             }
+            InputError::Attributes(e) => e.fmt(f),
         }
     }
 }
@@ -98,7 +106,14 @@ impl IndexedMesh {
         Self {
             positions,
             triangles,
+            attributes: Attributes::default(),
         }
+    }
+
+    /// The mesh with `attributes` (unchecked, like [`IndexedMesh::new`]).
+    pub fn with_attributes(mut self, attributes: Attributes) -> Self {
+        self.attributes = attributes;
+        self
     }
 
     /// Number of vertices (referenced or not).
@@ -112,8 +127,10 @@ impl IndexedMesh {
     }
 
     /// Checks what every later stage relies on: at least one triangle, counts within
-    /// [`MAX_ELEMENTS`], finite coordinates, indices in range. Reports the first problem
-    /// found, vertices before faces.
+    /// [`MAX_ELEMENTS`], finite coordinates, indices in range, and attributes that fit
+    /// the triangles (one corner triple per triangle, indices in range, finite values,
+    /// labels in range). Reports the first problem found: vertices, then faces, then
+    /// attributes.
     pub fn validate(&self) -> Result<(), InputError> {
         for (what, count) in [
             ("vertices", self.positions.len()),
@@ -149,7 +166,9 @@ impl IndexedMesh {
                 }
             }
         }
-        Ok(())
+        self.attributes
+            .validate(self.triangles.len())
+            .map_err(InputError::Attributes)
     }
 
     /// The axis-aligned bounding box of all positions as `(min, max)`, or `None` when

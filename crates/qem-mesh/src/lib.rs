@@ -1,6 +1,8 @@
 //! Topology and the simplification algorithm of qem.
 //!
 //! - [`IndexedMesh`]: the plain input and output type, with validation.
+//! - [`attributes`]: texture coordinates, normals, colours per corner; materials and
+//!   groups per face.
 //! - [`clean`]: weld, drop degenerate and duplicate faces, with counts.
 //! - [`MeshStore`]: the non-manifold adjacency store that contractions mutate.
 //! - [`pairs`]: virtual pairs (close vertices that share no edge) from a uniform grid.
@@ -9,6 +11,7 @@
 //! - `io` (feature `io`): readers and writers for OBJ, PLY, STL and OFF, with `.gz`.
 #![forbid(unsafe_code)]
 
+pub mod attributes;
 pub mod clean;
 pub mod cluster;
 pub mod input;

@@ -22,7 +22,7 @@
 //! and properties may hold any bytes (Latin-1 names from CAD exports are common); a
 //! UTF-8 byte order mark, `\r\n` line ends and tabs are accepted. What was passed over
 //! is counted in [`LoadedMesh::notes`] ([`ReadNotes`]); OBJ names are kept byte for
-//! byte ([`ObjAttributes`]). Numbers, counts and indices stay strict: a malformed one
+//! byte ([`crate::attributes::FaceLabels`]). Numbers, counts and indices stay strict: a malformed one
 //! is an error naming its line.
 //!
 //! **Bounded memory.** Counts above `MAX_ELEMENTS` are refused; no buffer is reserved
@@ -73,7 +73,6 @@ pub use atomic::{
     TEMP_MARKER,
 };
 pub use error::{IoError, Location, ReadError, ReadErrorKind};
-pub use obj::ObjAttributes;
 
 use crate::IndexedMesh;
 
@@ -176,10 +175,10 @@ fn strip_gz(name: &str) -> Option<&str> {
 #[derive(Clone, Debug, Default, PartialEq)]
 #[non_exhaustive]
 pub struct LoadedMesh {
-    /// The triangles and positions; passes [`IndexedMesh::validate`].
+    /// The triangles, positions and attributes (texture coordinates, normals,
+    /// colours, materials, groups: what the format and the file carry); passes
+    /// [`IndexedMesh::validate`].
     pub mesh: IndexedMesh,
-    /// Texture coordinates, normals and names of an OBJ file (`None` for other formats).
-    pub obj: Option<ObjAttributes>,
     /// What the reader passed over without using it.
     pub notes: ReadNotes,
 }
@@ -267,16 +266,13 @@ fn read_plain(bytes: &[u8], format: Format) -> Result<LoadedMesh, ReadError> {
         notes.byte_order_mark = bom;
         rest
     };
-    let (mesh, obj) = match format {
-        Format::Obj => {
-            let (mesh, attrs) = obj::read(text, &mut notes)?;
-            (mesh, Some(attrs))
-        }
-        Format::Ply => (ply::read(text, &mut notes)?, None),
-        Format::Stl => (stl::read(text, &mut notes)?, None),
-        Format::Off => (off::read(text, &mut notes)?, None),
+    let mesh = match format {
+        Format::Obj => obj::read(text, &mut notes)?,
+        Format::Ply => ply::read(text, &mut notes)?,
+        Format::Stl => stl::read(text, &mut notes)?,
+        Format::Off => off::read(text, &mut notes)?,
     };
-    let loaded = LoadedMesh { mesh, obj, notes };
+    let loaded = LoadedMesh { mesh, notes };
     // The parsers report most problems with a place; this is the safety net that makes
     // the documented guarantee hold whatever they missed.
     loaded
@@ -350,6 +346,80 @@ pub fn read_path(path: &Path) -> Result<LoadedMesh, IoError> {
         source,
     })?;
     read_bytes(&bytes, format).map_err(read_err)
+}
+
+/// Something a mesh carries that a format cannot hold, and why: what a writer leaves
+/// out, for the caller's report (see [`unwritable`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Unwritable {
+    /// What is left out: a channel's name, `materials`, `groups` or `material
+    /// libraries`.
+    pub what: String,
+    /// Why, in a few words.
+    pub reason: &'static str,
+}
+
+/// What writing `attributes` in `format` leaves out, in the order of the channels and
+/// then the labels; empty when the format keeps everything.
+///
+/// ```
+/// use qem_mesh::attributes::{Attributes, Channel, ChannelKind};
+/// use qem_mesh::io::{unwritable, Format};
+/// let mut attributes = Attributes::default();
+/// attributes.channels.push(Channel::new(ChannelKind::TexCoord, vec![0.0, 0.0], vec![[0; 3]]));
+/// assert!(unwritable(&attributes, Format::Obj).is_empty());
+/// assert_eq!(unwritable(&attributes, Format::Stl)[0].what, "uv");
+/// ```
+pub fn unwritable(attributes: &crate::attributes::Attributes, format: Format) -> Vec<Unwritable> {
+    use crate::attributes::ChannelKind;
+    let mut out = Vec::new();
+    let mut seen = Vec::new();
+    for c in &attributes.channels {
+        let first_of_kind = !seen.contains(&c.kind);
+        seen.push(c.kind);
+        let reason = match format {
+            Format::Stl => Some("STL holds positions only"),
+            Format::Obj => match c.kind {
+                ChannelKind::TexCoord | ChannelKind::Normal if first_of_kind => None,
+                ChannelKind::TexCoord | ChannelKind::Normal => {
+                    Some("OBJ holds one texture coordinate and one normal per corner")
+                }
+                ChannelKind::Color | ChannelKind::Generic => {
+                    Some("OBJ holds no colours or other channels per corner")
+                }
+            },
+            Format::Ply | Format::Off => Some("not written in this format yet"),
+        };
+        if let Some(reason) = reason {
+            out.push(Unwritable {
+                what: c.name.clone(),
+                reason,
+            });
+        }
+    }
+    let labels = [
+        ("materials", !attributes.materials.is_empty()),
+        ("groups", !attributes.groups.is_empty()),
+        (
+            "material libraries",
+            !attributes.material_libraries.is_empty(),
+        ),
+    ];
+    for (what, present) in labels {
+        let reason = match format {
+            Format::Obj => None,
+            Format::Stl => Some("STL holds positions only"),
+            Format::Ply => Some("PLY has no materials or groups"),
+            Format::Off => Some("OFF has no materials or groups"),
+        };
+        if let Some(reason) = reason.filter(|_| present) {
+            out.push(Unwritable {
+                what: what.to_string(),
+                reason,
+            });
+        }
+    }
+    out
 }
 
 /// Writes `mesh` in `format` to `out` (uncompressed). See the [module docs](self) for

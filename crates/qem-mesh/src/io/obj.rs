@@ -45,46 +45,11 @@
 use std::io::Write;
 
 use super::text::{self, parse_f64, parse_i64, show, words};
-use std::collections::HashSet;
+use std::collections::HashMap;
 
 use super::{sniff, Format, Location, ReadError, ReadNotes};
+use crate::attributes::{Channel, ChannelKind, FaceLabels};
 use crate::{IndexedMesh, InputError};
-
-/// Texture coordinates and normals of an OBJ file, indexed per triangle corner, and the
-/// names it carries.
-///
-/// `texcoord_indices` and `normal_indices` are either empty (the file has none) or hold
-/// one entry per triangle of [`LoadedMesh::mesh`](super::LoadedMesh::mesh), in the
-/// same order; a corner without a texture coordinate or normal holds
-/// [`ObjAttributes::MISSING`].
-///
-/// Names are kept byte for byte (OBJ does not say how names are encoded, and Latin-1
-/// names are common in CAD exports): each is the rest of its line after the keyword,
-/// without the ASCII whitespace around it, listed once, in order of first appearance.
-/// Which faces a name applies to is not kept (yet).
-#[derive(Clone, Debug, Default, PartialEq)]
-#[non_exhaustive]
-pub struct ObjAttributes {
-    /// `vt` values (u, v) that faces use.
-    pub texcoords: Vec<[f64; 2]>,
-    /// `vn` values that faces use.
-    pub normals: Vec<[f64; 3]>,
-    /// Per triangle corner, an index into `texcoords`.
-    pub texcoord_indices: Vec<[u32; 3]>,
-    /// Per triangle corner, an index into `normals`.
-    pub normal_indices: Vec<[u32; 3]>,
-    /// Names of `o` and `g` lines.
-    pub groups: Vec<Vec<u8>>,
-    /// Names of `usemtl` lines.
-    pub materials: Vec<Vec<u8>>,
-    /// File names of `mtllib` lines (not opened).
-    pub material_libraries: Vec<Vec<u8>>,
-}
-
-impl ObjAttributes {
-    /// The index of a corner that has no texture coordinate or normal.
-    pub const MISSING: u32 = u32::MAX;
-}
 
 /// Counts of `v`, `vt` and `vn` lines in the file.
 #[derive(Clone, Copy, Default)]
@@ -110,31 +75,152 @@ struct Scan {
     /// Byte ranges to overwrite with spaces in the copy given to `tobj`.
     blank: Vec<std::ops::Range<usize>>,
     names: Names,
+    /// Where the group and the material change, in triangles of the file's order.
+    group_runs: Vec<LabelRun>,
+    material_runs: Vec<LabelRun>,
+    /// Triangles the file's faces make (fan triangulation: a face of n corners makes
+    /// n - 2, a face of fewer than 3 none, as in `tobj`).
+    triangles: usize,
+    /// Which triangle corners have no `vt` or `vn` index ([`Slots`]).
+    slots: Slots,
     notes: ReadNotes,
 }
 
-/// Distinct names in order of first appearance (the set only answers "seen?").
+/// Distinct names in order of first appearance (the maps answer "seen, and where?").
 #[derive(Default)]
 struct Names {
     groups: Vec<Vec<u8>>,
     materials: Vec<Vec<u8>>,
     libraries: Vec<Vec<u8>>,
-    seen: [HashSet<Vec<u8>>; 3],
+    seen: [HashMap<Vec<u8>, u32>; 3],
 }
 
 impl Names {
-    fn add(&mut self, which: usize, name: &[u8]) {
-        if name.is_empty() || self.seen[which].contains(name) {
-            return;
+    /// Adds a name of kind `which` (0 groups, 1 materials, 2 libraries) and returns
+    /// its index, or [`FaceLabels::NONE`] for an empty name.
+    fn add(&mut self, which: usize, name: &[u8]) -> u32 {
+        if name.is_empty() {
+            return FaceLabels::NONE;
         }
-        self.seen[which].insert(name.to_vec());
+        if let Some(&i) = self.seen[which].get(name) {
+            return i;
+        }
         let list = match which {
             0 => &mut self.groups,
             1 => &mut self.materials,
             _ => &mut self.libraries,
         };
+        let i = list.len() as u32;
+        self.seen[which].insert(name.to_vec(), i);
         list.push(name.to_vec());
+        i
     }
+}
+
+/// Which corners of the file's triangles name a texture coordinate and a normal.
+///
+/// Why: `tobj` fills a corner without a `vt` (or `vn`) index with its neighbour's, or
+/// with the file's first value, when other faces of its section have one; the reader
+/// marks those corners [`Channel::MISSING`] instead. Kept as runs of triangles whose
+/// corners all agree (a file is nearly always one run), plus the corners of the rare
+/// faces that mix.
+#[derive(Default)]
+struct Slots {
+    /// From triangle `.0` on: whether every corner has a `vt` (`.1`) and a `vn` (`.2`).
+    runs: Vec<(usize, bool, bool)>,
+    /// Corners of faces that mix: (triangle, corner, has `vt`, has `vn`).
+    mixed: Vec<(usize, usize, bool, bool)>,
+}
+
+impl Slots {
+    /// Notes the face line `rest`, whose first triangle is `first`.
+    fn add_face(&mut self, rest: &[u8], first: usize) {
+        let mut all = (true, true);
+        let mut none = (true, true);
+        for corner in words(rest) {
+            let has = corner_slots(corner);
+            all = (all.0 && has.0, all.1 && has.1);
+            none = (none.0 && !has.0, none.1 && !has.1);
+        }
+        let uniform = (all.0 || none.0) && (all.1 || none.1);
+        if uniform {
+            if self.runs.last().is_none_or(|r| (r.1, r.2) != all) {
+                self.runs.push((first, all.0, all.1));
+            }
+            return;
+        }
+        // Fan triangulation: triangle j of the face has corners 0, j + 1, j + 2.
+        let corners: Vec<(bool, bool)> = words(rest).map(corner_slots).collect();
+        for j in 0..corners.len().saturating_sub(2) {
+            for (k, c) in [0, j + 1, j + 2].into_iter().enumerate() {
+                self.mixed.push((first + j, k, corners[c].0, corners[c].1));
+            }
+        }
+        // The run after a mixed face starts fresh.
+        self.runs
+            .push((first + corners.len().saturating_sub(2), true, true));
+    }
+
+    /// Marks the corners without an index as missing in `uv` and `normal`.
+    fn apply(&self, uv: Option<&mut Channel>, normal: Option<&mut Channel>, triangles: usize) {
+        for (which, channel) in [(0, uv), (1, normal)] {
+            let Some(channel) = channel else { continue };
+            for (i, &(first, has_uv, has_normal)) in self.runs.iter().enumerate() {
+                let has = if which == 0 { has_uv } else { has_normal };
+                let end = self
+                    .runs
+                    .get(i + 1)
+                    .map_or(triangles, |r| r.0)
+                    .min(triangles);
+                if !has {
+                    if let Some(span) = channel.corners.get_mut(first.min(end)..end) {
+                        span.fill([Channel::MISSING; 3]);
+                    }
+                }
+            }
+            for &(t, k, has_uv, has_normal) in &self.mixed {
+                let has = if which == 0 { has_uv } else { has_normal };
+                if let Some(c) = channel.corners.get_mut(t).filter(|_| !has) {
+                    c[k] = Channel::MISSING;
+                }
+            }
+        }
+    }
+}
+
+/// Whether a face corner `v/vt/vn` names a texture coordinate and a normal.
+fn corner_slots(corner: &[u8]) -> (bool, bool) {
+    let mut parts = corner.split(|&b| b == b'/').skip(1);
+    let vt = parts.next().is_some_and(|p| !p.is_empty());
+    let vn = parts.next().is_some_and(|p| !p.is_empty());
+    (vt, vn)
+}
+
+/// Where the group or material changes: from triangle `first` on (in file order),
+/// the faces have `label`.
+#[derive(Clone, Copy)]
+struct LabelRun {
+    first: usize,
+    label: u32,
+}
+
+/// Per-face labels from their runs, for `triangles` triangles; empty when there was
+/// no label line.
+fn expand_runs(runs: &[LabelRun], triangles: usize) -> Vec<u32> {
+    if runs.is_empty() {
+        return Vec::new();
+    }
+    let mut faces = vec![FaceLabels::NONE; triangles];
+    for (i, run) in runs.iter().enumerate() {
+        let end = runs
+            .get(i + 1)
+            .map_or(triangles, |r| r.first)
+            .min(triangles);
+        if let Some(span) = faces.get_mut(run.first.min(end)..end) {
+            span.fill(run.label);
+        }
+    }
+    faces
 }
 
 /// Whether `tobj` refuses this `usemtl` line: it takes the name after the first space
@@ -285,11 +371,19 @@ fn prescan(bytes: &[u8], detailed: bool) -> Result<Scan, ReadError> {
                     check_corner(corner, faces, so_far, total, at)?;
                 }
                 faces += usize::from(key == b"f");
+                if key == b"f" {
+                    scan.slots.add_face(rest, scan.triangles);
+                    scan.triangles += words(rest).count().saturating_sub(2);
+                }
                 // Lines and points are read (their indices guard tobj) but not kept.
                 scan.notes.skipped_lines += usize::from(key == b"l");
             }
             b"o" | b"g" => {
-                scan.names.add(0, text::trim(rest));
+                let label = scan.names.add(0, text::trim(rest));
+                scan.group_runs.push(LabelRun {
+                    first: scan.triangles,
+                    label,
+                });
                 // `tobj` starts a new model at every `o`/`g` line, which decides the
                 // vertex order: keep the keyword, hide a name it cannot take as text.
                 if utf8_error.is_some() {
@@ -297,7 +391,11 @@ fn prescan(bytes: &[u8], detailed: bool) -> Result<Scan, ReadError> {
                 }
             }
             b"usemtl" => {
-                scan.names.add(1, text::trim(rest));
+                let label = scan.names.add(1, text::trim(rest));
+                scan.material_runs.push(LabelRun {
+                    first: scan.triangles,
+                    label,
+                });
                 if utf8_error.is_some() || tobj_refuses_usemtl(line) {
                     scan.blank.push(whole);
                 }
@@ -412,10 +510,7 @@ fn check_corner(
     Ok(())
 }
 
-pub(crate) fn read(
-    bytes: &[u8],
-    notes: &mut ReadNotes,
-) -> Result<(IndexedMesh, ObjAttributes), ReadError> {
+pub(crate) fn read(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, ReadError> {
     // tobj does not know line continuations ("\\" at the end of a line, used for
     // long faces); join them first, keeping byte offsets, and remember where.
     let (joined, joins) = join_continuations(bytes);
@@ -458,21 +553,60 @@ pub(crate) fn read(
                 ));
             }
         };
-    let (mesh, mut attrs) = assemble(&models);
+    let mut mesh = assemble(&models);
+    let Scan {
+        names,
+        group_runs,
+        material_runs,
+        triangles,
+        slots,
+        notes: n,
+        ..
+    } = scan;
+    if triangles != mesh.triangles.len() {
+        // The scan and tobj disagree about the faces, so the labels cannot be placed:
+        // say so rather than guess (no file seen so far does this).
+        return Err(ReadError::malformed(
+            Location::Line(0),
+            format!(
+                "the faces make {triangles} triangles by fan triangulation, but tobj made {}",
+                mesh.triangles.len()
+            ),
+        ));
+    }
+    {
+        let mut uv = None;
+        let mut normal = None;
+        for c in &mut mesh.attributes.channels {
+            match c.kind {
+                ChannelKind::TexCoord => uv = Some(c),
+                ChannelKind::Normal => normal = Some(c),
+                _ => {}
+            }
+        }
+        slots.apply(uv, normal, triangles);
+    }
+    // A list no corner uses (values without any face naming them) is no channel.
+    mesh.attributes
+        .channels
+        .retain(|c| c.corners.iter().flatten().any(|&i| i != Channel::MISSING));
+    mesh.attributes.groups = FaceLabels {
+        names: names.groups,
+        faces: expand_runs(&group_runs, triangles),
+    };
+    mesh.attributes.materials = FaceLabels {
+        names: names.materials,
+        faces: expand_runs(&material_runs, triangles),
+    };
+    mesh.attributes.material_libraries = names.libraries;
     if let Err(e) = mesh.validate() {
         // Say where, when the detailed scan can (e.g. a non-finite coordinate).
         prescan(source, true).map_err(located)?;
         return Err(ReadError::mesh(None, e));
     }
-    let Scan {
-        names, notes: n, ..
-    } = scan;
-    attrs.groups = names.groups;
-    attrs.materials = names.materials;
-    attrs.material_libraries = names.libraries;
     notes.skipped_lines += n.skipped_lines;
     notes.non_utf8_lines += n.non_utf8_lines;
-    Ok((mesh, attrs))
+    Ok(mesh)
 }
 
 /// Replaces every `\\` that ends a line, and the line break after it, by spaces.
@@ -520,14 +654,16 @@ fn physical_line(e: ReadError, joined: &[u8], joins: &[usize]) -> ReadError {
     }
 }
 
-/// Concatenates tobj's models into one mesh with attributes.
-fn assemble(models: &[tobj::Model]) -> (IndexedMesh, ObjAttributes) {
+/// Concatenates tobj's models into one mesh, with its texture coordinates and
+/// normals as channels (corners without one hold [`Channel::MISSING`]).
+fn assemble(models: &[tobj::Model]) -> IndexedMesh {
     let mut mesh = IndexedMesh::default();
-    let mut attrs = ObjAttributes::default();
     let any_tex = models.iter().any(|m| !m.mesh.texcoord_indices.is_empty());
     let any_norm = models.iter().any(|m| !m.mesh.normal_indices.is_empty());
     let tri_total: usize = models.iter().map(|m| m.mesh.indices.len() / 3).sum();
     mesh.triangles.reserve(tri_total);
+    let mut uv = Channel::new(ChannelKind::TexCoord, Vec::new(), Vec::new());
+    let mut normal = Channel::new(ChannelKind::Normal, Vec::new(), Vec::new());
     for m in models {
         let m = &m.mesh;
         let base = mesh.positions.len() as u32;
@@ -538,32 +674,30 @@ fn assemble(models: &[tobj::Model]) -> (IndexedMesh, ObjAttributes) {
             .extend(tris.map(|t| [base + t[0], base + t[1], base + t[2]]));
         let ntri = m.indices.len() / 3;
         if any_tex {
-            let tbase = attrs.texcoords.len() as u32;
-            attrs
-                .texcoords
-                .extend(m.texcoords.chunks_exact(2).map(|c| [c[0], c[1]]));
-            push_corners(
-                &mut attrs.texcoord_indices,
-                &m.texcoord_indices,
-                tbase,
-                ntri,
-            );
+            let tbase = uv.value_count() as u32;
+            // f32: what every consumer of texture coordinates (GPUs, glTF) holds.
+            uv.values.extend(m.texcoords.iter().map(|&x| x as f32));
+            push_corners(&mut uv.corners, &m.texcoord_indices, tbase, ntri);
         }
         if any_norm {
-            let nbase = attrs.normals.len() as u32;
-            attrs
-                .normals
-                .extend(m.normals.chunks_exact(3).map(|c| [c[0], c[1], c[2]]));
-            push_corners(&mut attrs.normal_indices, &m.normal_indices, nbase, ntri);
+            let nbase = normal.value_count() as u32;
+            normal.values.extend(m.normals.iter().map(|&x| x as f32));
+            push_corners(&mut normal.corners, &m.normal_indices, nbase, ntri);
         }
     }
-    (mesh, attrs)
+    if any_tex {
+        mesh.attributes.channels.push(uv);
+    }
+    if any_norm {
+        mesh.attributes.channels.push(normal);
+    }
+    mesh
 }
 
 /// Appends `ntri` corner triples from `src` offset by `base`, or MISSING when `src`
 /// does not cover them.
 fn push_corners(dst: &mut Vec<[u32; 3]>, src: &[u32], base: u32, ntri: usize) {
-    let miss = ObjAttributes::MISSING;
+    let miss = Channel::MISSING;
     for t in 0..ntri {
         let corner = |k: usize| src.get(3 * t + k).map_or(miss, |&i| base + i);
         dst.push([corner(0), corner(1), corner(2)]);
@@ -578,11 +712,64 @@ pub(crate) fn write(out: &mut impl Write, mesh: &IndexedMesh) -> std::io::Result
         mesh.positions.len(),
         mesh.triangles.len()
     )?;
+    let attrs = &mesh.attributes;
+    for library in &attrs.material_libraries {
+        out.write_all(b"mtllib ")?;
+        out.write_all(library)?;
+        out.write_all(b"\n")?;
+    }
     for [x, y, z] in &mesh.positions {
         writeln!(out, "v {x} {y} {z}")?;
     }
-    for [a, b, c] in &mesh.triangles {
-        writeln!(out, "f {} {} {}", a + 1, b + 1, c + 1)?;
+    // OBJ has one slot for texture coordinates and one for normals: the first channel
+    // of each kind. (Other channels cannot be written in OBJ; the caller's report says
+    // which were dropped: [`super::unwritable`].)
+    let uv = attrs.channel(ChannelKind::TexCoord);
+    let normal = attrs.channel(ChannelKind::Normal);
+    if let Some(uv) = uv {
+        for v in uv.values.chunks_exact(2) {
+            writeln!(out, "vt {} {}", v[0], v[1])?;
+        }
+    }
+    if let Some(normal) = normal {
+        for v in normal.values.chunks_exact(3) {
+            writeln!(out, "vn {} {} {}", v[0], v[1], v[2])?;
+        }
+    }
+    let (mut group, mut material) = (FaceLabels::NONE, FaceLabels::NONE);
+    for (t, corners) in mesh.triangles.iter().enumerate() {
+        for (labels, current, keyword) in [
+            (&attrs.groups, &mut group, &b"g"[..]),
+            (&attrs.materials, &mut material, &b"usemtl"[..]),
+        ] {
+            let Some(&label) = labels.faces.get(t) else {
+                continue;
+            };
+            if label != *current {
+                *current = label;
+                out.write_all(keyword)?;
+                if let Some(name) = labels.names.get(label as usize) {
+                    out.write_all(b" ")?;
+                    out.write_all(name)?;
+                }
+                out.write_all(b"\n")?;
+            }
+        }
+        out.write_all(b"f")?;
+        for (k, &vertex) in corners.iter().enumerate() {
+            let index = |c: Option<&Channel>| {
+                // MISSING (u32::MAX) has no 1-based number: the slot stays empty.
+                c.and_then(|c| c.corners[t][k].checked_add(1))
+            };
+            write!(out, " {}", vertex + 1)?;
+            match (index(uv), index(normal)) {
+                (None, None) => {}
+                (Some(vt), None) => write!(out, "/{vt}")?,
+                (None, Some(vn)) => write!(out, "//{vn}")?,
+                (Some(vt), Some(vn)) => write!(out, "/{vt}/{vn}")?,
+            }
+        }
+        out.write_all(b"\n")?;
     }
     Ok(())
 }

@@ -711,14 +711,13 @@ impl Engine {
                 vertex_from.push(self.vertex_from[v]);
             }
         }
-        let mesh = IndexedMesh {
+        let mesh = IndexedMesh::new(
             positions,
-            triangles: self
-                .live
+            self.live
                 .iter()
                 .map(|&t| self.triangles[t as usize].map(|c| number[c as usize]))
                 .collect(),
-        };
+        );
         let triangle_from: Vec<u32> = self
             .live
             .iter()

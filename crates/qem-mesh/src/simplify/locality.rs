@@ -84,10 +84,7 @@ pub(super) fn in_locality_order(mesh: &IndexedMesh, frame: &Frame) -> Renumbered
         .map(|&old| corners[old as usize])
         .collect();
     Renumbered {
-        mesh: IndexedMesh {
-            positions,
-            triangles,
-        },
+        mesh: IndexedMesh::new(positions, triangles),
         vertex_from,
         vertex_to,
         triangle_from,
@@ -124,10 +121,7 @@ pub(super) fn in_original_order(
         .map(|(t, &from)| (from, t.map(|v| new_number[v as usize])))
         .collect();
     triangles.par_sort_unstable_by_key(|&(from, _)| from);
-    IndexedMesh {
-        positions,
-        triangles: triangles.into_iter().map(|(_, t)| t).collect(),
-    }
+    IndexedMesh::new(positions, triangles.into_iter().map(|(_, t)| t).collect())
 }
 
 /// The numbers of `triangles` stably sorted by their lowest corner (a counting sort:

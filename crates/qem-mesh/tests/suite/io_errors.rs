@@ -6,6 +6,7 @@ use std::io::Write;
 use std::path::Path;
 
 use proptest::prelude::*;
+use qem_mesh::attributes::ChannelKind;
 use qem_mesh::io::{read_bytes, read_path, write_path, write_to, Format};
 use qem_mesh::IndexedMesh;
 
@@ -219,15 +220,19 @@ fn obj_keeps_texcoords_normals_and_fans_polygons() {
     let obj = b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\nusemtl\nf 1/1/1 2/2/1 3/3/1 \\\n 4/4/1\n";
     let loaded = read_bytes(obj, Format::Obj).unwrap();
     assert_eq!(loaded.mesh.triangles.len(), 2);
-    let a = loaded.obj.unwrap();
-    assert_eq!(a.texcoords.len(), 4);
-    assert_eq!(a.normals, vec![[0.0, 0.0, 1.0]]);
-    assert_eq!(a.texcoord_indices.len(), 2);
+    let a = &loaded.mesh.attributes;
+    let uvs = a.channel(ChannelKind::TexCoord).unwrap();
+    let normals = a.channel(ChannelKind::Normal).unwrap();
+    assert_eq!(uvs.value_count(), 4);
+    assert_eq!(normals.values, vec![0.0, 0.0, 1.0]);
+    assert_eq!(uvs.corners.len(), 2);
     let p = &loaded.mesh.positions;
-    let uv = |t: usize, k: usize| a.texcoords[a.texcoord_indices[t][k] as usize];
+    let uv = |t: usize, k: usize| uvs.at_corner(t, k).unwrap().to_vec();
     // Fan from the first corner, and each corner keeps its own texture coordinate.
     assert_eq!(p[loaded.mesh.triangles[1][2] as usize], [0.0, 1.0, 0.0]);
     assert_eq!(uv(1, 2), [0.0, 1.0]);
+    // A bare `usemtl` names nothing: the faces have no material.
+    assert!(a.materials.names.is_empty());
 }
 
 #[test]

@@ -67,9 +67,9 @@ fn latin1_names_bom_and_crlf_load_and_keep_their_names() {
         corners(&load(plain, Format::Obj).mesh)
     );
 
-    let obj = loaded.obj.as_ref().unwrap();
+    let obj = &loaded.mesh.attributes;
     assert_eq!(
-        obj.groups,
+        obj.groups.names,
         vec![
             b"Bygning".to_vec(),
             b"Terraind\xe6k".to_vec(),
@@ -77,10 +77,14 @@ fn latin1_names_bom_and_crlf_load_and_keep_their_names() {
         ]
     );
     assert_eq!(
-        obj.materials,
+        obj.materials.names,
         vec![b"Terraind\xe6k".to_vec(), b"Tagpap_gr\xe5".to_vec()]
     );
     assert_eq!(obj.material_libraries, vec![b"terr\xe6n.mtl".to_vec()]);
+    // Which face has which: `o Bygning` holds no face; the tab-separated `usemtl`
+    // (which tobj refuses) still names the last four faces' material.
+    assert_eq!(obj.groups.faces, vec![1, 1, 2, 2, 2, 2]);
+    assert_eq!(obj.materials.faces, vec![0, 0, 1, 1, 1, 1]);
     // Skipped: `s off` and `cstype`. Not UTF-8: the comment, mtllib, g, 2 usemtl.
     assert_eq!(loaded.notes, notes(2, 0, 5, true));
 }
@@ -122,7 +126,7 @@ fn obj_unknown_lines_with_any_bytes_are_skipped_and_counted() {
     let loaded = load(obj, Format::Obj);
     assert_eq!(loaded.mesh.triangle_count(), 1);
     assert_eq!(loaded.notes, notes(1, 0, 1, false));
-    assert!(loaded.obj.unwrap().materials.is_empty());
+    assert!(loaded.mesh.attributes.materials.names.is_empty());
 }
 
 #[test]

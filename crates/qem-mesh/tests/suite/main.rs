@@ -9,6 +9,8 @@
 mod common;
 mod passes_common;
 
+#[cfg(feature = "io")]
+mod attributes_obj;
 mod bvh_extremes;
 mod cluster;
 mod exact_quadrics;
