@@ -34,14 +34,14 @@ pub struct SimplifyJson {
     cleanup: BTreeMap<&'static str, usize>,
     degenerate_faces_removed: usize,
     /// Contractions refused, by reason: `degenerate`, `flip`, `sliver`, `topology`,
-    /// `locked`, `border`, `merge`, `orientation`, `last_triangles`.
+    /// `locked`, `border`, `merge`, `orientation`, `last_triangles`, `seam`.
     rejected: BTreeMap<&'static str, usize>,
     /// The steps of the ladder of relaxations the run climbed (none unless it got
     /// stuck), in order, each with the contractions made under it.
     relaxations: Vec<RelaxationJson>,
     /// With `stop_reason` `no_valid_pair`: what stopped the run (`strict`,
     /// `preserve_topology`, `locks`, `locked_boundary`, `zero_area`, `last_triangles`,
-    /// `no_pairs`); null otherwise.
+    /// `seams`, `no_pairs`); null otherwise.
     stopped_by: Option<&'static str>,
     /// Vertices locked (by --lock or --lock-boundary).
     locked_vertices: usize,

@@ -4,6 +4,8 @@
 //!   Simplification Using Quadric Error Metrics", SIGGRAPH 97), stored as 10 f64.
 //! - [`optimal_placement`]: where a contracted pair's new vertex goes, with the paper's
 //!   fallback chain and a relative singularity test.
+//! - [`AttributeQuadric`]: the error of texture coordinates, normals and colours beside
+//!   the position (Garland–Heckbert 98, in Hoppe 99's form).
 //! - [`Frame`]: normalised coordinates and conversion of errors back to world units and
 //!   to fractions of the bounding-box diagonal.
 //!
@@ -21,11 +23,13 @@
 //! ```
 #![forbid(unsafe_code)]
 
+mod attribute;
 mod frame;
 mod plane;
 mod quadric;
 mod solve;
 
+pub use attribute::{AttributeQuadric, MAX_COMPONENTS};
 pub use frame::Frame;
 pub use glam::DVec3;
 pub use plane::WeightedPlane;

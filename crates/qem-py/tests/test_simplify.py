@@ -29,7 +29,7 @@ def test_returns_valid_arrays_and_a_report(sphere):
     )
     assert set(report["rejected"]) == {
         "degenerate", "flip", "sliver", "topology", "locked", "border", "merge",
-        "orientation", "last_triangles",
+        "orientation", "last_triangles", "seam",
     }
     assert report["timings_ms"]["simplify"] >= report["timings_ms"]["contract"] >= 0
 

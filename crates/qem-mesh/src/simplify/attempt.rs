@@ -147,12 +147,16 @@ impl Engine {
             }
             None => self.place(a, b),
         };
-        let error = q.rms_distance(placed.cost);
+        let error = q.rms_distance(self.geometric_cost(&q, &placed));
         if error > self.settings.max_error_bound {
             return Attempt::OverErrorBound;
         }
         let world = self.world_position(a, &placed, any_locked);
-        if let Err(why) = self.check(a, b, world, shared, around, merged) {
+        let seam = self
+            .wedges
+            .as_ref()
+            .map_or(Ok(()), |w| w.pairing(a, b, &around[0]).map(|_| ()));
+        if let Err(why) = seam.and_then(|()| self.check(a, b, world, shared, around, merged)) {
             self.counters.reject(why);
             return Attempt::Refused;
         }
@@ -183,6 +187,9 @@ impl Engine {
         }
         if let Some(pairs) = &mut self.virtual_pairs {
             pairs.contract(a, b, |_, _| {});
+        }
+        if let Some(wedges) = &mut self.wedges {
+            wedges.contract(a, b, around);
         }
         let (mut slab, fixed) = self.split();
         let removed = slab.contract(&fixed, [a, b], world, q, around, merged);

@@ -26,6 +26,8 @@ pub(super) enum Rejection {
     Orientation,
     /// The contraction would remove the last triangles.
     LastTriangles,
+    /// The contraction would join the two sides of an attribute seam.
+    Seam,
 }
 
 /// `4√3·area / (l₀² + l₁² + l₂²)` from twice the area (`double_area`): 1 for an

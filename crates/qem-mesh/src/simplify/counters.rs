@@ -47,6 +47,7 @@ impl Counters {
             Rejection::Merge => &mut self.rejected.merge,
             Rejection::Orientation => &mut self.rejected.orientation,
             Rejection::LastTriangles => &mut self.rejected.last_triangles,
+            Rejection::Seam => &mut self.rejected.seam,
         };
         *counter += 1;
     }

@@ -39,6 +39,7 @@ use super::relaxation::Ladder;
 use super::report::StopReason;
 use super::settings::Settings;
 use super::waivers::{penalised, Waivers};
+use super::wedges::Wedges;
 use crate::inspect::{find, union};
 use crate::pairs::grid::{virtual_pairs, GridOptions};
 use crate::store::build::kept_triangles;
@@ -143,6 +144,9 @@ pub(super) struct Engine {
     virtual_pairs: Option<PairSet>,
     /// The ladder of relaxations' record ([`super::ladder`]).
     pub ladder: Ladder,
+    /// The attributes' wedges ([`super::wedges`]); `None` for a mesh without
+    /// attribute channels or materials, which pays nothing for them.
+    pub(super) wedges: Option<Wedges>,
 }
 
 /// A [`Fixed`] borrowing the fields of the engine `$engine`, with the orientation
@@ -260,12 +264,21 @@ impl Engine {
             greedy: greedy::Greedy::default(),
             virtual_pairs: None,
             ladder: Ladder::default(),
+            wedges: None,
         };
         engine.set_block_vertices(BLOCK_VERTICES);
         // The incident lists first: the quadrics are summed along them.
         engine.list_incident_triangles();
         let area_offset = engine.sum_face_planes(options);
         engine.initialise_boundary(options, area_offset);
+        engine.wedges = Wedges::new(
+            &cleaned.attributes,
+            &engine.triangles,
+            &engine.triangle_from,
+            &engine.position,
+            &options.attribute_weights,
+        );
+        engine.add_seam_planes(options, area_offset);
         for &i in locked {
             if let Some(&v) = vertex_to.get(i as usize) {
                 engine.locked[v as usize] = true;
@@ -513,19 +526,45 @@ impl Engine {
                 self.locked[x as usize] = true;
                 continue;
             };
-            let [p0, p1, p2] = self.corners(self.triangles[t as usize]);
-            let normal = (p1 - p0).cross(p2 - p0).normalize_or_zero();
-            let (pa, pb) = (self.position[v as usize], self.position[x as usize]);
-            let plane_weight = match area_offset {
-                Some(extra) => w * (pa.distance_squared(pb) + extra),
-                None => w,
-            };
-            let q = Quadric::boundary_constraint(pa, pb, normal, plane_weight);
-            self.quadric[v as usize] += q;
-            self.quadric[x as usize] += q;
-            if let Some(exact) = &mut self.exact {
-                exact.add_border_plane(v, x, q);
-            }
+            self.add_constraint_plane([v, x], t, w, area_offset);
+        }
+    }
+
+    /// The constraint plane of the edge `v x` of triangle `t` (through the edge,
+    /// perpendicular to the triangle), of weight `w` (times the edge's squared length
+    /// plus `area_offset` with area weights), added to both ends' quadrics.
+    fn add_constraint_plane(&mut self, [v, x]: [u32; 2], t: u32, w: f64, area_offset: Option<f64>) {
+        let [p0, p1, p2] = self.corners(self.triangles[t as usize]);
+        let normal = (p1 - p0).cross(p2 - p0).normalize_or_zero();
+        let (pa, pb) = (self.position[v as usize], self.position[x as usize]);
+        let plane_weight = match area_offset {
+            Some(extra) => w * (pa.distance_squared(pb) + extra),
+            None => w,
+        };
+        let q = Quadric::boundary_constraint(pa, pb, normal, plane_weight);
+        self.quadric[v as usize] += q;
+        self.quadric[x as usize] += q;
+        if let Some(exact) = &mut self.exact {
+            exact.add_border_plane(v, x, q);
+        }
+    }
+
+    /// Seam edges get the borders' constraint planes (with [`BoundaryMode::Planes`]),
+    /// one for each triangle on the edge, so that a seam keeps its curve as a border
+    /// does ([`super::wedges`]).
+    fn add_seam_planes(&mut self, options: &SimplifyOptions, area_offset: Option<f64>) {
+        let BoundaryMode::Planes(w) = options.boundary else {
+            return;
+        };
+        let Some(wedges) = &self.wedges else {
+            return;
+        };
+        if !(w > 0.0 && w.is_finite()) {
+            return;
+        }
+        let seams = wedges.seam_edges(&self.incidence, &self.triangles, self.position.len());
+        for (v, x, t) in seams {
+            self.add_constraint_plane([v, x], t, w, area_offset);
         }
     }
 
@@ -658,13 +697,39 @@ impl Engine {
     }
 
     /// [`place`](Self::place) with the merged quadric `q` of `a` and `b` given.
+    ///
+    /// With attributes the placement weighs their error too (its cost is the
+    /// geometric and the attribute error together, and a pair that would join a
+    /// seam's sides costs +∞); the quadric returned is the geometric one.
     fn place_with(&self, a: u32, b: u32, q: Quadric) -> (Placement, Quadric) {
-        let (a, b) = (a as usize, b as usize);
         let ends = [
-            (self.position[a], self.locked[a]),
-            (self.position[b], self.locked[b]),
+            (self.position[a as usize], self.locked[a as usize]),
+            (self.position[b as usize], self.locked[b as usize]),
         ];
-        (place_merged(&q, ends, self.settings.placement), q)
+        let Some(wedges) = &self.wedges else {
+            return (place_merged(&q, ends, self.settings.placement), q);
+        };
+        match wedges.merged_error(&self.incidence, &self.triangles, a, b) {
+            Some(attributes) => (
+                place_merged(&(q + attributes), ends, self.settings.placement),
+                q,
+            ),
+            None => {
+                let mut placed = place_merged(&q, ends, self.settings.placement);
+                placed.cost = f64::INFINITY;
+                (placed, q)
+            }
+        }
+    }
+
+    /// The geometric part of a placement's cost: the cost itself, or with attributes
+    /// the geometric quadric `q` at the placed point (the error the report and the
+    /// error bound speak of).
+    pub(super) fn geometric_cost(&self, q: &Quadric, placed: &Placement) -> f64 {
+        match self.wedges {
+            None => placed.cost,
+            Some(_) => q.evaluate(placed.position).max(0.0),
+        }
     }
 
     /// The quadric of `a` and `b` merged: `Q_a + Q_b`, less `Q_ab` with exact quadrics.
@@ -711,13 +776,21 @@ impl Engine {
                 vertex_from.push(self.vertex_from[v]);
             }
         }
-        let mesh = IndexedMesh::new(
+        let mut mesh = IndexedMesh::new(
             positions,
             self.live
                 .iter()
                 .map(|&t| self.triangles[t as usize].map(|c| number[c as usize]))
                 .collect(),
         );
+        if let Some(wedges) = &self.wedges {
+            mesh.attributes = wedges.output(
+                &self.live,
+                &self.triangles,
+                &self.triangle_from,
+                &self.position,
+            );
+        }
         let triangle_from: Vec<u32> = self
             .live
             .iter()

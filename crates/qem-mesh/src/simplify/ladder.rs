@@ -123,6 +123,7 @@ fn constraint_behind(refused: &Refusals, options: &SimplifyOptions) -> Constrain
         (refused.border, by_border),
         (refused.degenerate, Constraint::ZeroArea),
         (refused.last_triangles, Constraint::LastTriangles),
+        (refused.seam, Constraint::Seams),
     ];
     // The first of the largest, so the order above breaks ties; none refused: no pairs.
     let none = (0, Constraint::NoPairs);

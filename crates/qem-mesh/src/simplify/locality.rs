@@ -120,8 +120,15 @@ pub(super) fn in_original_order(
         .zip(triangle_from)
         .map(|(t, &from)| (from, t.map(|v| new_number[v as usize])))
         .collect();
+    // With attributes, the permutation itself, to take them along.
+    let attributes = (!mesh.attributes.is_empty()).then(|| {
+        let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
+        order.par_sort_unstable_by_key(|&k| triangles[k as usize].0);
+        mesh.attributes.for_faces(&order)
+    });
     triangles.par_sort_unstable_by_key(|&(from, _)| from);
     IndexedMesh::new(positions, triangles.into_iter().map(|(_, t)| t).collect())
+        .with_attributes(attributes.unwrap_or_default())
 }
 
 /// The numbers of `triangles` stably sorted by their lowest corner (a counting sort:

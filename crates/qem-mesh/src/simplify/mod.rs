@@ -53,12 +53,13 @@ mod replay;
 mod report;
 mod settings;
 mod waivers;
+mod wedges;
 
 pub use observer::{Contraction, NoObserver, Observer, Progress};
 pub use options::{
-    BoundaryMode, ContractionOrder, Length, Method, PlacementMode, QuadricMode, SimplifyOptions,
-    Target, VirtualPairs, Weighting, DEFAULT_BOUNDARY_WEIGHT, DEFAULT_MAX_NORMAL_ANGLE,
-    DEFAULT_MIN_TRIANGLE_QUALITY, DEFAULT_WEIGHTING_MIX,
+    AttributeWeights, BoundaryMode, ContractionOrder, Length, Method, PlacementMode, QuadricMode,
+    SimplifyOptions, Target, VirtualPairs, Weighting, DEFAULT_BOUNDARY_WEIGHT,
+    DEFAULT_MAX_NORMAL_ANGLE, DEFAULT_MIN_TRIANGLE_QUALITY, DEFAULT_WEIGHTING_MIX,
 };
 pub use relaxation::{Constraint, Relaxation, RelaxationStep};
 pub use replay::StoreReplay;
@@ -224,13 +225,23 @@ pub fn simplify_levels(
         // `checks::is_zero_area`): the loop refused every contraction that would make a
         // face zero-area, so this drops only faces that came in so (cleaning passes off).
         let before = raw.triangles.len();
-        raw.triangles.retain(|t| {
-            !checks::is_zero_area(
+        let zero_area = |t: &[u32; 3]| {
+            checks::is_zero_area(
                 &engine.frame,
                 &engine.settings,
                 t.map(|i| raw.positions[i as usize]),
             )
-        });
+        };
+        if raw.attributes.is_empty() {
+            raw.triangles.retain(|t| !zero_area(t));
+        } else {
+            // The attributes go with their faces.
+            let kept: Vec<u32> = (0..before as u32)
+                .filter(|&t| !zero_area(&raw.triangles[t as usize]))
+                .collect();
+            raw.triangles = kept.iter().map(|&t| raw.triangles[t as usize]).collect();
+            raw.attributes = raw.attributes.for_faces(&kept);
+        }
         let zero_area_dropped = before - raw.triangles.len();
         let final_clean = clean(&raw, &CleanOptions::OUTPUT.with_drop_zero_area(false));
         let out = final_clean.mesh;

@@ -1,5 +1,6 @@
 //! What a simplification may do: [`SimplifyOptions`] and the small enums it is made of.
 
+use crate::attributes::ChannelKind;
 use crate::clean::CleanOptions;
 use qem_core::Frame;
 
@@ -276,6 +277,63 @@ pub struct SimplifyOptions {
     /// Pair contraction (every option above) or vertex clustering (see [`Method`]).
     /// Default: `Method::Contraction`.
     pub method: Method,
+    /// How much texture coordinates, normals and colours weigh against positions, for
+    /// meshes that carry them (see [`crate::attributes`]). Default:
+    /// `AttributeWeights::DEFAULT`.
+    pub attribute_weights: AttributeWeights,
+}
+
+/// How much each kind of channel weighs against positions (in the normalised frame,
+/// where the bounding box spans about 2): an attribute difference of 1 costs as much
+/// as a distance of `weight` there.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct AttributeWeights {
+    /// Texture coordinates. Default 1.
+    pub uv: f64,
+    /// Normals (unit vectors). Default 0.5.
+    pub normal: f64,
+    /// Colours (0–1). Default 1.
+    pub colour: f64,
+    /// Generic channels. Default 1.
+    pub generic: f64,
+}
+
+impl AttributeWeights {
+    /// The defaults.
+    pub const DEFAULT: AttributeWeights = AttributeWeights {
+        uv: 1.0,
+        normal: 0.5,
+        colour: 1.0,
+        generic: 1.0,
+    };
+
+    /// The weights with `kind`'s set to `weight`.
+    pub const fn with(mut self, kind: ChannelKind, weight: f64) -> Self {
+        match kind {
+            ChannelKind::TexCoord => self.uv = weight,
+            ChannelKind::Normal => self.normal = weight,
+            ChannelKind::Color => self.colour = weight,
+            ChannelKind::Generic => self.generic = weight,
+        }
+        self
+    }
+
+    /// The weight of a channel of `kind`.
+    pub fn of(&self, kind: ChannelKind) -> f64 {
+        match kind {
+            ChannelKind::TexCoord => self.uv,
+            ChannelKind::Normal => self.normal,
+            ChannelKind::Color => self.colour,
+            ChannelKind::Generic => self.generic,
+        }
+    }
+}
+
+impl Default for AttributeWeights {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
 }
 
 /// How a mesh is simplified.
@@ -362,6 +420,7 @@ impl SimplifyOptions {
         order: ContractionOrder::Greedy,
         strict: false,
         method: Method::Contraction,
+        attribute_weights: AttributeWeights::DEFAULT,
     };
 
     /// [`DEFAULT`](Self::DEFAULT) in [`ContractionOrder::Passes`], with summed quadrics
@@ -411,6 +470,7 @@ impl SimplifyOptions {
         order: ContractionOrder::Passes,
         strict: false,
         method: Method::Contraction,
+        attribute_weights: AttributeWeights::DEFAULT,
     };
 
     /// [`DEFAULT`](Self::DEFAULT) with [`Method::Clustering`]: vertex clustering
@@ -500,6 +560,12 @@ impl SimplifyOptions {
     /// Sets [`min_triangle_quality`](Self::min_triangle_quality).
     pub fn with_min_triangle_quality(mut self, quality: f64) -> Self {
         self.min_triangle_quality = quality;
+        self
+    }
+
+    /// Sets [`attribute_weights`](Self::attribute_weights).
+    pub fn with_attribute_weights(mut self, weights: AttributeWeights) -> Self {
+        self.attribute_weights = weights;
         self
     }
 

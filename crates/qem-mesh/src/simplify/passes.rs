@@ -150,8 +150,10 @@ impl Engine {
             .is_none_or(|s| s.hint_count() == self.triangles.len());
         // (Nor where merges are allowed: a merge removes faces at the pair's neighbours,
         // and more than two triangles, which the blocks' bound on the target assumes.)
+        // (Nor with attributes: their wedges are not split into blocks.)
         !self.settings.any_locked
             && !self.settings.allow_merges
+            && self.wedges.is_none()
             && hints_per_triangle
             && self.position.len() > self.block_vertices as usize
     }
@@ -574,7 +576,7 @@ impl Engine {
             quadric,
             faces: SmallVec::new(),
         };
-        let error = quadric.rms_distance(placed.cost);
+        let error = quadric.rms_distance(self.geometric_cost(&quadric, &placed));
         let Some(surface) = &self.input_surface else {
             return Some(speculation);
         };

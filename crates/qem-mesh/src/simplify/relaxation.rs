@@ -100,6 +100,9 @@ pub enum Constraint {
     /// The output keeps at least one triangle: a target of 0, or of fewer triangles
     /// than the last contractions remove at once.
     LastTriangles,
+    /// The attribute seams: every pair left would join the two sides of a seam (a UV
+    /// seam, a hard normal, a colour or material border).
+    Seams,
     /// No pair was left to try (every vertex alone, or the error bound).
     NoPairs,
 }
@@ -114,6 +117,7 @@ impl Constraint {
             Constraint::LockedBoundary => "locked_boundary",
             Constraint::ZeroArea => "zero_area",
             Constraint::LastTriangles => "last_triangles",
+            Constraint::Seams => "seams",
             Constraint::NoPairs => "no_pairs",
         }
     }

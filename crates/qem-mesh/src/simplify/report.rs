@@ -220,6 +220,10 @@ pub struct Refusals {
     /// Contractions refused because they would have removed the last triangles: the
     /// output keeps at least one.
     pub last_triangles: usize,
+    /// Contractions refused because they would have joined the two sides of an
+    /// attribute seam (a UV seam, a hard normal, a colour or material border); only on
+    /// meshes with attributes.
+    pub seam: usize,
 }
 
 impl Refusals {
@@ -235,6 +239,7 @@ impl Refusals {
             merge,
             orientation,
             last_triangles,
+            seam,
         } = *self;
         degenerate
             + flip
@@ -245,11 +250,12 @@ impl Refusals {
             + merge
             + orientation
             + last_triangles
+            + seam
     }
 
     /// Every count with its snake_case name, as used in JSON reports (the CLI's and
     /// the Python package's `rejected`).
-    pub fn named(&self) -> [(&'static str, usize); 9] {
+    pub fn named(&self) -> [(&'static str, usize); 10] {
         [
             ("degenerate", self.degenerate),
             ("flip", self.flip),
@@ -260,6 +266,7 @@ impl Refusals {
             ("merge", self.merge),
             ("orientation", self.orientation),
             ("last_triangles", self.last_triangles),
+            ("seam", self.seam),
         ]
     }
 
@@ -274,6 +281,7 @@ impl Refusals {
         self.merge += other.merge;
         self.orientation += other.orientation;
         self.last_triangles += other.last_triangles;
+        self.seam += other.seam;
     }
 
     /// These counts less `earlier`'s (an earlier copy of the same counters).
@@ -288,6 +296,7 @@ impl Refusals {
             merge: self.merge - earlier.merge,
             orientation: self.orientation - earlier.orientation,
             last_triangles: self.last_triangles - earlier.last_triangles,
+            seam: self.seam - earlier.seam,
         }
     }
 }

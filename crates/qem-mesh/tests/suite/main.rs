@@ -11,6 +11,7 @@ mod passes_common;
 
 #[cfg(feature = "io")]
 mod attributes_obj;
+mod attributes_simplify;
 mod bvh_extremes;
 mod cluster;
 mod exact_quadrics;

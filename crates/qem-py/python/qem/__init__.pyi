@@ -76,12 +76,12 @@ class Report(TypedDict):
     degenerate_faces_removed: int
     rejected: dict[str, int]
     """Contractions refused, by reason: degenerate, flip, sliver, topology, locked,
-    border, merge, orientation, last_triangles."""
+    border, merge, orientation, last_triangles, seam."""
     relaxations: list[Relaxation]
     """The steps of the ladder of relaxations the run climbed because no pair passed
     every check, in order (empty when it never got stuck)."""
     stopped_by: Literal["strict", "preserve_topology", "locks", "locked_boundary",
-                        "zero_area", "last_triangles", "no_pairs"] | None
+                        "zero_area", "last_triangles", "seams", "no_pairs"] | None
     """With stop_reason "no_valid_pair": what stopped the run; None otherwise."""
     locked_vertices: int
     faces_flipped: int
