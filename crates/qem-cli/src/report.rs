@@ -1,7 +1,8 @@
 //! JSON reports, written atomically. Field names are the documented JSON keys.
 
+use qem_mesh::attributes::Attributes;
 use qem_mesh::inspect::MeshInfo;
-use qem_mesh::io::ReadNotes;
+use qem_mesh::io::{unwritable, Format, ReadNotes};
 use qem_mesh::simplify::SimplifyReport;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -51,7 +52,91 @@ pub struct SimplifyJson {
     /// What the reader passed over (issue 33): `skipped_lines`, `skipped_properties`,
     /// `non_utf8_lines`, `byte_order_mark`.
     read_notes: ReadNotesJson,
+    /// The attribute channels and labels of the input that the output file carries,
+    /// and those it does not, each with the reason.
+    attributes: AttributesJson,
     timings_ms: BTreeMap<&'static str, f64>,
+}
+
+/// What became of the input's attributes (issue 29): `carried` names the channels
+/// (`uv`, `normal`, `colour`, ...) and labels (`materials`, `groups`, `material
+/// libraries`) the output file holds; `dropped` the others, with the reason.
+#[derive(Serialize, Debug, Clone, Default)]
+pub struct AttributesJson {
+    carried: Vec<String>,
+    dropped: Vec<DroppedJson>,
+}
+
+/// An attribute the output does not carry, and why.
+#[derive(Serialize, Debug, Clone)]
+pub struct DroppedJson {
+    what: String,
+    reason: String,
+}
+
+impl AttributesJson {
+    /// What became of `input`'s attributes in the simplified mesh's `output`,
+    /// written in `format`.
+    pub fn new(input: &Attributes, output: &Attributes, format: Format) -> Self {
+        let present = |a: &Attributes| -> Vec<String> {
+            let mut names: Vec<String> = a.channels.iter().map(|c| c.name.clone()).collect();
+            for (what, there) in [
+                ("materials", !a.materials.is_empty()),
+                ("groups", !a.groups.is_empty()),
+                ("material libraries", !a.material_libraries.is_empty()),
+            ] {
+                if there {
+                    names.push(what.to_string());
+                }
+            }
+            names
+        };
+        let kept = present(output);
+        let not_written = unwritable(output, format);
+        let mut json = AttributesJson::default();
+        for what in present(input) {
+            if !kept.contains(&what) {
+                json.dropped.push(DroppedJson {
+                    what,
+                    reason: "vertex clustering keeps positions only".to_string(),
+                });
+            } else if let Some(u) = not_written.iter().find(|u| u.what == what) {
+                json.dropped.push(DroppedJson {
+                    what,
+                    reason: u.reason.to_string(),
+                });
+            } else {
+                json.carried.push(what);
+            }
+        }
+        json
+    }
+
+    /// `carried: uv, normal; dropped: colour (STL holds positions only)`, or `None`
+    /// when the input had no attributes.
+    pub fn summary(&self) -> Option<String> {
+        if self.carried.is_empty() && self.dropped.is_empty() {
+            return None;
+        }
+        let dropped: Vec<String> = self
+            .dropped
+            .iter()
+            .map(|d| format!("{} ({})", d.what, d.reason))
+            .collect();
+        Some(format!(
+            "attributes carried: {}; dropped: {}",
+            if self.carried.is_empty() {
+                "none".to_string()
+            } else {
+                self.carried.join(", ")
+            },
+            if dropped.is_empty() {
+                "none".to_string()
+            } else {
+                dropped.join(", ")
+            },
+        ))
+    }
 }
 
 /// A step of the ladder of relaxations the run climbed.
@@ -147,8 +232,15 @@ impl SimplifyJson {
             locked_vertices: r.locked_vertices,
             faces_flipped: r.faces_flipped,
             read_notes: notes.into(),
+            attributes: AttributesJson::default(),
             timings_ms,
         }
+    }
+
+    /// The report with what became of the input's attributes.
+    pub fn with_attributes(mut self, attributes: AttributesJson) -> Self {
+        self.attributes = attributes;
+        self
     }
 }
 
@@ -168,7 +260,8 @@ impl SimplifyJson {
     ///
     /// A run that got stuck adds the relaxations it climbed (`; relaxed: fold_over 12,
     /// merged_faces 3`), and one that stopped short with no pair left what stopped it
-    /// (`(no_valid_pair: last_triangles)`).
+    /// (`(no_valid_pair: last_triangles)`). A mesh with attributes adds what was
+    /// carried and dropped (`; attributes carried: uv; dropped: none`).
     pub fn summary_line(&self) -> String {
         let stop = match self.stopped_by {
             Some(by) => format!("{}: {by}", self.stop_reason),
@@ -184,8 +277,12 @@ impl SimplifyJson {
                 .collect();
             format!("; relaxed: {}", steps.join(", "))
         };
+        let attributes = self
+            .attributes
+            .summary()
+            .map_or(String::new(), |s| format!("; {s}"));
         format!(
-            "{} → {}: {} → {} triangles, max error {:.4}% of the bounding-box diagonal ({stop}){relaxed}",
+            "{} → {}: {} → {} triangles, max error {:.4}% of the bounding-box diagonal ({stop}){relaxed}{attributes}",
             self.input,
             self.output,
             self.triangles_in,

@@ -4,7 +4,7 @@
 use crate::failure::Failure;
 use crate::options::{parse_ratio, SimplifyFlags};
 use crate::progress::{bars_wanted, interrupted, simplify_bar, BarObserver};
-use crate::report::{write_json_atomically, LevelJson, LevelsJson, SimplifyJson};
+use crate::report::{write_json_atomically, AttributesJson, LevelJson, LevelsJson, SimplifyJson};
 use clap::Args;
 use qem_mesh::io::{read_path, write_path, Format, ReadNotes};
 use qem_mesh::simplify::{
@@ -123,7 +123,19 @@ pub fn simplify_file(
         load,
         simplify_time,
         write,
-    ))
+    )
+    .with_attributes(attributes_of(&mesh, &result, output)))
+}
+
+/// What became of `mesh`'s attributes in `result`, written to `output`.
+fn attributes_of(
+    mesh: &qem_mesh::IndexedMesh,
+    result: &Simplified,
+    output: &Path,
+) -> AttributesJson {
+    // The output's name was checked before it was written, so it has a format.
+    let format = Format::from_path(output).unwrap_or(Format::Obj);
+    AttributesJson::new(&mesh.attributes, &result.mesh.attributes, format)
 }
 
 fn load(input: &Path) -> Result<(qem_mesh::IndexedMesh, ReadNotes, Duration), Failure> {
@@ -180,10 +192,10 @@ fn run_levels(args: &SimplifyArgs) -> Result<(), Failure> {
             &mut BarObserver::new(&bar),
         )
         .map_err(|e| Failure::Failed(format!("{}: {e}", args.input.display())))?;
-        Ok((levels, notes, load, clock.elapsed()))
+        Ok((mesh, levels, notes, load, clock.elapsed()))
     })();
     bar.finish_and_clear();
-    let (levels, notes, load, simplify_time) = result?;
+    let (mesh, levels, notes, load, simplify_time) = result?;
     if interrupted()
         || levels
             .iter()
@@ -207,7 +219,8 @@ fn run_levels(args: &SimplifyArgs) -> Result<(), Failure> {
             load,
             simplify_time,
             write,
-        );
+        )
+        .with_attributes(attributes_of(&mesh, level, output));
         if !args.quiet {
             eprintln!("level {lod} (ratio {ratio}): {}", run.summary_line());
         }

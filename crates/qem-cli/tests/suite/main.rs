@@ -8,6 +8,7 @@
 
 mod common;
 
+mod attributes_cli;
 mod batch_cli;
 mod hostile_input;
 mod info_cli;

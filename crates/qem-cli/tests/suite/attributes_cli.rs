@@ -1,0 +1,67 @@
+//! `qem simplify` keeps what the mesh carries and says so in its report.
+#![allow(clippy::unwrap_used)]
+
+use crate::common::{qem, spot, stderr};
+use qem_mesh::attributes::ChannelKind;
+
+/// Runs `qem simplify spot.obj -o <name> --ratio 0.1 --report` and returns the
+/// written mesh and the report.
+fn simplify_spot(name: &str) -> (qem_mesh::IndexedMesh, serde_json::Value) {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join(name);
+    let report = dir.path().join("report.json");
+    let o = qem(&[
+        "simplify",
+        spot().to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--ratio",
+        "0.1",
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let json = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    (qem_mesh::io::read_path(&out).unwrap().mesh, json)
+}
+
+#[test]
+fn spot_keeps_its_uvs_in_obj_and_the_report_says_so() {
+    let (mesh, json) = simplify_spot("spot-10.obj");
+    assert!(mesh.triangle_count() <= 585);
+    let uv = mesh
+        .attributes
+        .channel(ChannelKind::TexCoord)
+        .expect("the output has texture coordinates");
+    assert!(uv.corners.iter().flatten().all(|&i| i != u32::MAX));
+    // Values within the input's range (a best value at a moved vertex interpolates
+    // its triangles' fields; it may pass their extremes only by a little).
+    let input = qem_mesh::io::read_path(&spot()).unwrap().mesh;
+    let input_uv = &input
+        .attributes
+        .channel(ChannelKind::TexCoord)
+        .unwrap()
+        .values;
+    let lo = input_uv.iter().copied().fold(f32::INFINITY, f32::min);
+    let hi = input_uv.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+    assert!(
+        uv.values
+            .iter()
+            .all(|&x| (lo - 0.01..=hi + 0.01).contains(&x)),
+        "uvs outside [{lo}, {hi}]"
+    );
+    assert_eq!(json["attributes"]["carried"], serde_json::json!(["uv"]));
+    assert_eq!(json["attributes"]["dropped"], serde_json::json!([]));
+}
+
+#[test]
+fn stl_output_drops_the_uvs_and_the_report_says_why() {
+    let (mesh, json) = simplify_spot("spot-10.stl");
+    assert!(mesh.attributes.is_empty());
+    assert_eq!(json["attributes"]["carried"], serde_json::json!([]));
+    assert_eq!(json["attributes"]["dropped"][0]["what"], "uv");
+    assert_eq!(
+        json["attributes"]["dropped"][0]["reason"],
+        "STL holds positions only"
+    );
+}
