@@ -40,11 +40,13 @@
 //! assert!(m.samples_ab >= 1000);
 //! ```
 
+mod attributes;
 mod bvh;
 mod facing;
 mod pieces;
 
 use crate::input::{IndexedMesh, InputError};
+pub use attributes::{measure_attributes, ChannelError};
 pub use bvh::TriangleBvh;
 use rayon::prelude::*;
 use std::fmt;
@@ -510,18 +512,30 @@ impl<'m> SampleSet<'m> {
 
     /// One area-uniform face sample, drawn from `rng`.
     fn face_point(&self, rng: &mut SplitMix64) -> P3 {
+        let (t, weights) = self.face_sample(rng);
+        self.point(t, weights)
+    }
+
+    /// One area-uniform face sample, drawn from `rng`, as its triangle and barycentric
+    /// weights.
+    fn face_sample(&self, rng: &mut SplitMix64) -> (usize, [f64; 3]) {
         let total = self.cumulative_area.last().copied().unwrap_or(0.0);
         let r = rng.next_f64() * total;
         let f = self
             .cumulative_area
             .partition_point(|&c| c <= r)
             .min(self.cumulative_area.len() - 1);
-        let t = self.mesh.triangles[f];
         // Uniform in the triangle: Osada et al., "Shape distributions" (2002), eq. 1.
         let s1 = rng.next_f64().sqrt();
         let r2 = rng.next_f64();
         let (u, v) = (1.0 - s1, s1 * (1.0 - r2));
         let w = 1.0 - u - v;
+        (f, [u, v, w])
+    }
+
+    /// The point of triangle `t` with barycentric `weights`.
+    fn point(&self, t: usize, [u, v, w]: [f64; 3]) -> P3 {
+        let t = self.mesh.triangles[t];
         let (a, b, c) = (
             self.position(t[0]),
             self.position(t[1]),

@@ -1,10 +1,19 @@
 //! OBJ reader (on top of `tobj`) and writer.
 //!
 //! # What the reader keeps and what `tobj` changes
-//! Only `v`, `vt`, `vn` and `f` matter; `l` and `p` elements, points and lines written
-//! as `f` with one or two corners, materials, groups and smoothing groups are ignored.
-//! Polygons are fan-triangulated from their first corner (as `tobj` does with
-//! `triangulate`).
+//! Positions (`v`), faces (`f`), and the mesh's attributes
+//! ([`crate::attributes`]): texture coordinates (`vt`) and normals (`vn`) per corner,
+//! each face's group (`o`/`g`) and material (`usemtl`), and the material files
+//! (`mtllib`, not opened). A corner without a `vt` or `vn` index has none
+//! ([`Channel::MISSING`]): `tobj` would fill it with a neighbour's value, so the reader
+//! marks those corners from its own scan. `l` and `p` elements, points and lines
+//! written as `f` with one or two corners, and smoothing groups are ignored. Polygons
+//! are fan-triangulated from their first corner (as `tobj` does with `triangulate`),
+//! each triangle with its polygon's corners' values and labels.
+//!
+//! The writer writes all of it: `mtllib`, `v`, `vt`, `vn`, then the faces as
+//! `v/vt/vn` corners with a `g` or `usemtl` line wherever the group or material
+//! changes (the first channel of each kind: OBJ has one slot each).
 //!
 //! `tobj` splits the file into one model per `o`/`g`/`usemtl` section and numbers each
 //! model's vertices in the order its faces first use them. The reader concatenates the
@@ -32,7 +41,7 @@
 //! a new model there), `usemtl` lines `tobj` refuses (bare, or with a tab before the
 //! name) and unknown lines with non-ASCII bytes (where `tobj`'s Unicode whitespace and
 //! the scan's ASCII whitespace could disagree about the keyword). Names are kept byte
-//! for byte in [`ObjAttributes`]; skipped lines and lines that are not UTF-8 are
+//! for byte ([`FaceLabels`]); skipped lines and lines that are not UTF-8 are
 //! counted in [`ReadNotes`]. A UTF-8 byte order mark is skipped (by
 //! [`read_bytes`](super::read_bytes)); `\r\n` line ends and tabs are whitespace.
 //!
