@@ -38,7 +38,10 @@
 //!
 //! OBJ and OFF are text with coordinates written in Rust's shortest round-trip form,
 //! PLY is `binary_little_endian` with `double` coordinates: all three read back
-//! bit-exact. STL is binary with `float32` coordinates (the format has no
+//! bit-exact. Attributes go where each format has room for them (OBJ `vt`/`vn`,
+//! materials and groups; PLY and OFF per-vertex normals, colours and texture
+//! coordinates and face colours, PLY also generic properties); [`unwritable`] says what
+//! a format leaves out. STL is binary with `float32` coordinates (the format has no
 //! other choice) and facet normals computed from the triangles; a coordinate beyond
 //! float32's range (about ±3.4e38) is an `InvalidInput` error rather than an infinity
 //! in the file.
@@ -58,6 +61,7 @@
 //! ```
 
 mod atomic;
+mod channels;
 mod error;
 pub mod obj;
 mod off;
@@ -199,9 +203,12 @@ pub struct ReadNotes {
     /// grammar; OFF lines after the last face. Default 0.
     pub skipped_lines: usize,
     /// PLY properties the reader does not use, counted once per declaration in the
-    /// header: everything but `x`, `y`, `z` of the vertex element and the index list of
-    /// the face element (colours, normals, texture coordinates, properties of other
-    /// elements). Default 0.
+    /// header: list properties other than the face element's indices, face properties
+    /// other than its colour, all properties of other elements, and vertex properties
+    /// that are not kept as channels (a lone member of a colour, normal or texture
+    /// coordinate set such as `red` without `green`, a name another channel has, those
+    /// past the channel limit). Scalar vertex properties are otherwise kept as
+    /// channels ([`crate::attributes`]). Default 0.
     pub skipped_properties: usize,
     /// Text lines holding bytes that are not UTF-8 (in names and comments; Latin-1
     /// material names are common), read as bytes. Default 0.
@@ -372,31 +379,54 @@ pub struct Unwritable {
 /// ```
 pub fn unwritable(attributes: &crate::attributes::Attributes, format: Format) -> Vec<Unwritable> {
     use crate::attributes::ChannelKind;
-    let mut out = Vec::new();
-    let mut seen = Vec::new();
-    for c in &attributes.channels {
-        let first_of_kind = !seen.contains(&c.kind);
-        seen.push(c.kind);
-        let reason = match format {
-            Format::Stl => Some("STL holds positions only"),
-            Format::Obj => match c.kind {
-                ChannelKind::TexCoord | ChannelKind::Normal if first_of_kind => None,
-                ChannelKind::TexCoord | ChannelKind::Normal => {
-                    Some("OBJ holds one texture coordinate and one normal per corner")
-                }
-                ChannelKind::Color | ChannelKind::Generic => {
-                    Some("OBJ holds no colours or other channels per corner")
-                }
-            },
-            Format::Ply | Format::Off => Some("not written in this format yet"),
-        };
-        if let Some(reason) = reason {
-            out.push(Unwritable {
+    let channels = &attributes.channels;
+    let reasons: Vec<Option<&'static str>> = match format {
+        Format::Stl => vec![Some("STL holds positions only"); channels.len()],
+        Format::Obj => {
+            let mut seen = Vec::new();
+            channels
+                .iter()
+                .map(|c| {
+                    let first_of_kind = !seen.contains(&c.kind);
+                    seen.push(c.kind);
+                    match c.kind {
+                        ChannelKind::TexCoord | ChannelKind::Normal if first_of_kind => None,
+                        ChannelKind::TexCoord | ChannelKind::Normal => {
+                            Some("OBJ holds one texture coordinate and one normal per corner")
+                        }
+                        ChannelKind::Color | ChannelKind::Generic => {
+                            Some("OBJ holds no colours or other channels per corner")
+                        }
+                    }
+                })
+                .collect()
+        }
+        // The writers' own plans, so the report and the file cannot disagree.
+        Format::Ply => ply::placements(channels)
+            .into_iter()
+            .map(|p| match p {
+                ply::Placement::Left(reason) => Some(reason),
+                ply::Placement::Vertex(_) | ply::Placement::Face(_) => None,
+            })
+            .collect(),
+        Format::Off => off::slots(channels)
+            .into_iter()
+            .map(|s| match s {
+                off::Slot::Left(reason) => Some(reason),
+                off::Slot::Vertex | off::Slot::Face => None,
+            })
+            .collect(),
+    };
+    let mut out: Vec<Unwritable> = channels
+        .iter()
+        .zip(reasons)
+        .filter_map(|(c, reason)| {
+            reason.map(|reason| Unwritable {
                 what: c.name.clone(),
                 reason,
-            });
-        }
-    }
+            })
+        })
+        .collect();
     let labels = [
         ("materials", !attributes.materials.is_empty()),
         ("groups", !attributes.groups.is_empty()),
@@ -409,8 +439,8 @@ pub fn unwritable(attributes: &crate::attributes::Attributes, format: Format) ->
         let reason = match format {
             Format::Obj => None,
             Format::Stl => Some("STL holds positions only"),
-            Format::Ply => Some("PLY has no materials or groups"),
-            Format::Off => Some("OFF has no materials or groups"),
+            Format::Ply => Some("PLY has no materials, groups or material libraries"),
+            Format::Off => Some("OFF has no materials, groups or material libraries"),
         };
         if let Some(reason) = reason.filter(|_| present) {
             out.push(Unwritable {
@@ -423,9 +453,19 @@ pub fn unwritable(attributes: &crate::attributes::Attributes, format: Format) ->
 }
 
 /// Writes `mesh` in `format` to `out` (uncompressed). See the [module docs](self) for
-/// the exact encodings. A triangle index out of range, or an STL coordinate beyond
-/// float32, is an `InvalidInput` error; nothing else about the mesh is checked.
+/// the exact encodings and [`unwritable`] for what a format leaves out. A triangle
+/// index out of range, malformed attributes (what [`IndexedMesh::validate`] refuses in
+/// them), or an STL coordinate beyond float32, is an `InvalidInput` error; nothing else
+/// about the mesh is checked.
 pub fn write_to<W: Write>(out: W, mesh: &IndexedMesh, format: Format) -> std::io::Result<()> {
+    // The writers index channels by triangle and corner: checked here, so a malformed
+    // channel is an error rather than a panic.
+    if let Err(e) = mesh.attributes.validate(mesh.triangles.len()) {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            e.to_string(),
+        ));
+    }
     let n = mesh.positions.len();
     if let Some((face, &index)) = mesh
         .triangles

@@ -3,24 +3,62 @@
 //! Reads `ascii`, `binary_little_endian` and `binary_big_endian`. The `vertex` element
 //! must have scalar `x`, `y`, `z` properties (any numeric type; `float` and `double`
 //! are usual); the `face` element must have an integer list `vertex_indices` or
-//! `vertex_index` (any integer count and item types). Every other element and
-//! property, lists included, is skipped (and counted in
-//! [`ReadNotes::skipped_properties`]). Polygons are fan-triangulated.
+//! `vertex_index` (any integer count and item types). Polygons are fan-triangulated.
+//!
+//! # Attributes
+//! Scalar vertex properties become per-vertex channels (stored per corner: a corner's
+//! value is its vertex's):
+//! - colours `red green blue [alpha]`, or `diffuse_red diffuse_green diffuse_blue
+//!   [diffuse_alpha]`: a [`ChannelKind::Color`] of 3 or 4 floats. `uchar` (and any
+//!   integer type but `ushort`) is divided by 255, `ushort` by 65535, `float` and
+//!   `double` are taken as they are;
+//! - normals `nx ny nz`;
+//! - texture coordinates `s t`, `u v`, `texture_u texture_v` or `texture_s texture_t`;
+//! - every other scalar: a [`ChannelKind::Generic`] channel named after the property,
+//!   and `<name>_0`, `<name>_1`... (2 to 4 in a row) as one vector channel `<name>`.
+//!   Integers become floats (exact up to 2^24).
+//!
+//! Only the first complete set of each kind is read; a property named like a member of
+//! a set (`red`, `u`, ...) outside a complete set is skipped. The face element's
+//! colour (the same two sets) becomes a channel whose corners all use their face's
+//! value (each triangle of a polygon gets the polygon's), named `colour`, or
+//! `face_colour` when the vertices have one. Channel names are unique: a property
+//! whose name is taken is skipped. At most [`MAX_CHANNELS`] channels are read.
+//! A value that is not finite as a 32-bit float (`nan`, or a `double` beyond
+//! `f32`) is an error naming the element, its index and the property.
+//!
+//! What is skipped and counted in [`ReadNotes::skipped_properties`]: list properties
+//! other than the face's indices, face properties other than its colour, every
+//! property of other elements, and the vertex properties described above.
 //!
 //! Header lines are read as bytes: comments and names may hold any bytes (counted in
-//! [`ReadNotes::non_utf8_lines`] when not UTF-8), and a line whose keyword the format
-//! does not define (`comment`, `obj_info`, `format`, `element`, `property`,
-//! `end_header`) is skipped and counted in [`ReadNotes::skipped_lines`]. Types, counts
-//! and numbers stay strict: they decide where the geometry is.
+//! [`ReadNotes::non_utf8_lines`] when not UTF-8; names become channel names with
+//! invalid bytes replaced), and a line whose keyword the format does not define
+//! (`comment`, `obj_info`, `format`, `element`, `property`, `end_header`) is skipped
+//! and counted in [`ReadNotes::skipped_lines`]. Types, counts and numbers stay strict:
+//! they decide where the geometry is.
 //!
+//! # Writing
 //! Writes `binary_little_endian` with `double` coordinates (so positions read back
-//! exactly) and `list uchar int vertex_indices`.
+//! exactly) and `list uchar int vertex_indices`. Channels ([`placements`]) follow the
+//! coordinates, per vertex after splitting the vertices at their seams
+//! ([`split_at_seams`](crate::attributes::split_at_seams); channels the reader made are
+//! already per vertex and keep the vertices as they are): the first normals as
+//! `float nx ny nz`, the first texture coordinates as `float s t`, the first colour as
+//! `red green blue [alpha]`, generic channels as `float <name>` (vectors
+//! `<name>_0`...). A colour with one value per triangle (a face colour) is written on
+//! the faces instead. Colours are `uchar` when every component is exactly a level
+//! `k/255` (what `uchar` colours read as, so they come back bit-exact), `float`
+//! otherwise (so 0.3 is not rounded to 77/255). A corner without a value is written as
+//! zeros. A mesh without channels gives the same file as before attributes existed.
 
 use std::io::Write;
 
+use super::channels::{all_levels, from_level, is_face_colour, per_vertex, to_level};
 use super::off::fan;
-use super::text::{self, capacity_for, parse_f64, parse_i64, show, Tokens};
+use super::text::{self, capacity_for, parse_f32, parse_f64, parse_i64, show, Tokens};
 use super::{sniff, Format, Location, ReadError, ReadNotes};
+use crate::attributes::{Attributes, Channel, ChannelKind};
 use crate::{IndexedMesh, InputError, MAX_ELEMENTS};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -225,25 +263,122 @@ fn parse_header<'a>(bytes: &'a [u8], notes: &mut ReadNotes) -> Result<Header<'a>
     ))
 }
 
+/// At most this many attribute channels are read from one file; the properties of
+/// further ones are skipped and counted. Every channel holds three indices per
+/// triangle, so without a cap a header of many one-byte properties would make memory
+/// grow with properties times triangles, far beyond the file's size: 16 channels take
+/// 192 bytes per triangle, 48 times the smallest binary face record (4 bytes), and are
+/// more than scanners and exporters write (normal, colour, texture coordinates and a
+/// few scalars such as quality or intensity).
+pub(crate) const MAX_CHANNELS: usize = 16;
+
+/// Vertex properties read together as one channel, in the order the reader looks for
+/// them: the first complete set of each kind is read. A colour set's last name (alpha)
+/// is optional.
+const VERTEX_SETS: [(ChannelKind, &[&[u8]]); 7] = [
+    (ChannelKind::Color, &[b"red", b"green", b"blue", b"alpha"]),
+    (
+        ChannelKind::Color,
+        &[
+            b"diffuse_red",
+            b"diffuse_green",
+            b"diffuse_blue",
+            b"diffuse_alpha",
+        ],
+    ),
+    (ChannelKind::Normal, &[b"nx", b"ny", b"nz"]),
+    (ChannelKind::TexCoord, &[b"s", b"t"]),
+    (ChannelKind::TexCoord, &[b"u", b"v"]),
+    (ChannelKind::TexCoord, &[b"texture_u", b"texture_v"]),
+    (ChannelKind::TexCoord, &[b"texture_s", b"texture_t"]),
+];
+
+/// Whether the reader gives a vertex property's name a meaning (a coordinate or a
+/// member of [`VERTEX_SETS`]). Such a property outside a complete set is skipped rather
+/// than read as a generic channel, because written back under its name it would mean
+/// something else; the writer refuses generic channels with these names for the same
+/// reason.
+fn is_reserved(name: &[u8]) -> bool {
+    matches!(name, b"x" | b"y" | b"z") || VERTEX_SETS.iter().any(|(_, set)| set.contains(&name))
+}
+
+/// How a property's number becomes a channel's float.
+#[derive(Clone, Copy, Debug)]
+enum Convert {
+    /// A float property: its value, rounded to `f32`.
+    Float,
+    /// An integer property: its value divided by this (255 for `uchar` colours,
+    /// 65535 for `ushort` ones, 1 for everything else).
+    Level(f64),
+}
+
+impl Convert {
+    fn of(kind: ChannelKind, ty: Ty) -> Convert {
+        match (kind, ty) {
+            (_, Ty::F32 | Ty::F64) => Convert::Float,
+            (ChannelKind::Color, Ty::U16) => Convert::Level(65535.0),
+            // Integer colours of any other type follow the 0-255 convention of uchar.
+            (ChannelKind::Color, _) => Convert::Level(255.0),
+            _ => Convert::Level(1.0),
+        }
+    }
+}
+
 /// What the reader does with each property of an element.
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, Debug)]
 enum Role {
     Coord(usize),
     Indices,
+    /// Component `component` of the element's channel `channel`.
+    Value {
+        channel: usize,
+        component: usize,
+        convert: Convert,
+    },
     Skip,
 }
 
-fn roles(el: &Element, is_vertex: bool, is_face: bool) -> Result<Vec<Role>, ReadError> {
+/// Which element an element is for the reader: the first `vertex`, the first `face`,
+/// or another.
+#[derive(Clone, Copy, PartialEq)]
+enum Side {
+    Vertex,
+    Face,
+    Other,
+}
+
+/// A channel the reader fills from an element's properties.
+struct Planned {
+    kind: ChannelKind,
+    name: String,
+    dimension: usize,
+}
+
+/// How the reader reads one element.
+struct Plan {
+    roles: Vec<Role>,
+    /// The channels filled from the element, in the order of their first property.
+    channels: Vec<Planned>,
+}
+
+/// A channel's properties: (property index, component) pairs.
+type Members = Vec<(usize, usize)>;
+
+/// The plan for `el`; `names` holds the names of the channels planned so far (which
+/// must stay unique) and receives the new ones.
+fn plan(el: &Element, side: Side, names: &mut Vec<String>) -> Result<Plan, ReadError> {
     let at = Location::Line(el.line);
-    let mut roles = Vec::with_capacity(el.props.len());
+    let is_vertex = side == Side::Vertex;
+    let is_face = side == Side::Face;
+    let mut roles = vec![Role::Skip; el.props.len()];
     let mut found = [false; 3];
     let mut has_indices = false;
-    for &(name, prop) in &el.props {
-        let role = match (name, prop) {
+    for (role, &(name, prop)) in roles.iter_mut().zip(&el.props) {
+        match (name, prop) {
             (b"x" | b"y" | b"z", Prop::Scalar(_)) if is_vertex => {
                 let k = usize::from(name[0] - b'x');
                 found[k] = true;
-                Role::Coord(k)
+                *role = Role::Coord(k);
             }
             (b"vertex_indices" | b"vertex_index", Prop::List(_, it)) if is_face && !has_indices => {
                 if it.is_float() {
@@ -257,11 +392,10 @@ fn roles(el: &Element, is_vertex: bool, is_face: bool) -> Result<Vec<Role>, Read
                     ));
                 }
                 has_indices = true;
-                Role::Indices
+                *role = Role::Indices;
             }
-            _ => Role::Skip,
-        };
-        roles.push(role);
+            _ => {}
+        }
     }
     if is_vertex {
         if let Some(k) = found.iter().position(|f| !f) {
@@ -280,7 +414,119 @@ fn roles(el: &Element, is_vertex: bool, is_face: bool) -> Result<Vec<Role>, Read
             "the face element has no \"vertex_indices\" list property",
         ));
     }
-    Ok(roles)
+
+    // Candidate channels: kind, name and members, sets first.
+    let mut candidates: Vec<(ChannelKind, String, Members)> = Vec::new();
+    let scalar = |i: usize| matches!(el.props[i].1, Prop::Scalar(_));
+    let sets: &[(ChannelKind, &[&[u8]])] = match side {
+        Side::Vertex => &VERTEX_SETS,
+        // Faces carry colours only (the two colour sets).
+        Side::Face => &VERTEX_SETS[..2],
+        Side::Other => &[],
+    };
+    let mut member = vec![false; el.props.len()];
+    for &(kind, set) in sets {
+        if candidates.iter().any(|c| c.0 == kind) {
+            continue;
+        }
+        let required = if kind == ChannelKind::Color {
+            3
+        } else {
+            set.len()
+        };
+        let at: Vec<Option<usize>> = set
+            .iter()
+            .map(|n| (0..el.props.len()).find(|&i| el.props[i].0 == *n && scalar(i)))
+            .collect();
+        if at[..required].iter().any(Option::is_none) {
+            continue;
+        }
+        let members: Members = at
+            .iter()
+            .enumerate()
+            .filter_map(|(k, i)| i.map(|i| (i, k)))
+            .collect();
+        for &(i, _) in &members {
+            member[i] = true;
+        }
+        let name = if is_face && names.iter().any(|n| n == "colour") {
+            "face_colour".to_string()
+        } else {
+            kind.as_str().to_string()
+        };
+        candidates.push((kind, name, members));
+    }
+    if is_vertex {
+        // Every other scalar: a generic channel; `<base>_0`, `<base>_1`... (2 to 4 in a
+        // row) together, as the writer writes a generic vector.
+        let free = |i: usize| {
+            scalar(i) && !member[i] && !is_reserved(el.props[i].0) && matches!(roles[i], Role::Skip)
+        };
+        let mut i = 0;
+        while i < el.props.len() {
+            if !free(i) {
+                i += 1;
+                continue;
+            }
+            let name = el.props[i].0;
+            let mut len = 1;
+            if let Some(base) = name.strip_suffix(b"_0") {
+                while len < 4
+                    && i + len < el.props.len()
+                    && free(i + len)
+                    && el.props[i + len].0.strip_prefix(base) == Some(format!("_{len}").as_bytes())
+                {
+                    len += 1;
+                }
+            }
+            let shown = if len > 1 {
+                &name[..name.len() - 2]
+            } else {
+                name
+            };
+            candidates.push((
+                ChannelKind::Generic,
+                String::from_utf8_lossy(shown).into_owned(),
+                (i..i + len).enumerate().map(|(k, p)| (p, k)).collect(),
+            ));
+            i += len;
+        }
+    }
+
+    // Accepted in priority order (sets, then generics), kept in property order.
+    let mut accepted = Vec::new();
+    for (kind, name, members) in candidates {
+        if names.len() >= MAX_CHANNELS || names.contains(&name) {
+            continue;
+        }
+        names.push(name.clone());
+        accepted.push((kind, name, members));
+    }
+    accepted.sort_by_key(|(_, _, members)| members.iter().map(|m| m.0).min());
+    let mut channels = Vec::with_capacity(accepted.len());
+    for (c, (kind, name, members)) in accepted.into_iter().enumerate() {
+        for &(i, component) in &members {
+            if let Prop::Scalar(ty) = el.props[i].1 {
+                roles[i] = Role::Value {
+                    channel: c,
+                    component,
+                    convert: Convert::of(kind, ty),
+                };
+            }
+        }
+        channels.push(Planned {
+            kind,
+            name,
+            dimension: members.len(),
+        });
+    }
+    Ok(Plan { roles, channels })
+}
+
+/// One channel's values as they are read.
+struct Values {
+    dimension: usize,
+    data: Vec<f32>,
 }
 
 /// Mesh under construction, shared by the ascii and binary paths.
@@ -292,6 +538,13 @@ struct Builder {
     vertex_count: Option<usize>,
     corners: Vec<u32>,
     faces: usize,
+    /// The vertex element's channels, one value per vertex record.
+    vertex_values: Vec<Values>,
+    /// The face element's channels (a colour), one value per face record.
+    face_values: Vec<Values>,
+    /// For each triangle, the face record it comes from (kept only when the face
+    /// element has channels: a polygon's triangles share its values).
+    triangle_faces: Vec<u32>,
 }
 
 impl Builder {
@@ -346,8 +599,61 @@ impl Builder {
             ));
         }
         fan(&self.corners, &mut self.triangles);
+        if !self.face_values.is_empty() {
+            // faces < MAX_ELEMENTS (the header's count is checked), so it fits a u32.
+            self.triangle_faces.extend(std::iter::repeat_n(
+                self.faces as u32,
+                self.corners.len() - 2,
+            ));
+        }
         self.corners.clear();
         self.faces += 1;
+        Ok(())
+    }
+
+    fn values(&mut self, side: Side) -> &mut [Values] {
+        match side {
+            Side::Vertex => &mut self.vertex_values,
+            Side::Face => &mut self.face_values,
+            Side::Other => &mut [],
+        }
+    }
+
+    /// Starts a record of `side`'s element: a zero value in each of its channels, for
+    /// [`Builder::store`] to fill.
+    fn start_record(&mut self, side: Side) {
+        for v in self.values(side) {
+            v.data.extend(std::iter::repeat_n(0.0, v.dimension));
+        }
+    }
+
+    /// Stores component `component` of channel `channel` in the current record of
+    /// `side`'s element; a value that is not finite is an error naming record `r` of
+    /// `el` and the property (`shown`: the number as the file has it).
+    fn store(
+        &mut self,
+        side: Side,
+        (channel, component): (usize, usize),
+        value: f32,
+        (el, r, name): (&[u8], usize, &[u8]),
+        shown: impl FnOnce() -> String,
+        at: Location,
+    ) -> Result<(), ReadError> {
+        if !value.is_finite() {
+            return Err(ReadError::malformed(
+                at,
+                format!(
+                    "{} {r}: property \"{}\" is {}, not a finite 32-bit float",
+                    el.escape_ascii(),
+                    name.escape_ascii(),
+                    shown()
+                ),
+            ));
+        }
+        if let Some(v) = self.values(side).get_mut(channel) {
+            let i = v.data.len() - v.dimension + component;
+            v.data[i] = value;
+        }
         Ok(())
     }
 }
@@ -356,53 +662,104 @@ pub(crate) fn read(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, R
     let header = parse_header(bytes, notes)?;
     notes.non_utf8_lines += text::non_utf8_lines(bytes.get(..header.body).unwrap_or_default());
     let body = bytes.get(header.body..).unwrap_or_default();
+    // Which element is which, and the plans: the vertex element's first, so a face
+    // colour knows whether "colour" is taken whatever order the elements come in.
+    let mut sides = Vec::with_capacity(header.elements.len());
+    let (mut seen_vertex, mut seen_face) = (false, false);
+    for el in &header.elements {
+        let side = if el.name == b"vertex" && !seen_vertex {
+            seen_vertex = true;
+            Side::Vertex
+        } else if el.name == b"face" && !seen_face {
+            seen_face = true;
+            Side::Face
+        } else {
+            Side::Other
+        };
+        sides.push(side);
+    }
+    let mut names = Vec::new();
+    let mut plans: Vec<Option<Plan>> = header.elements.iter().map(|_| None).collect();
+    for wanted in [Side::Vertex, Side::Face, Side::Other] {
+        for ((el, &side), slot) in header.elements.iter().zip(&sides).zip(&mut plans) {
+            if side == wanted {
+                *slot = Some(plan(el, side, &mut names)?);
+            }
+        }
+    }
+    let plans: Vec<Plan> = plans.into_iter().flatten().collect();
+    let channels_of = |side: Side| -> Vec<Values> {
+        sides
+            .iter()
+            .zip(&plans)
+            .filter(|(&s, _)| s == side)
+            .flat_map(|(_, p)| &p.channels)
+            .map(|c| Values {
+                dimension: c.dimension,
+                data: Vec::new(),
+            })
+            .collect()
+    };
     let mut b = Builder {
         positions: Vec::new(),
         triangles: Vec::new(),
         vertex_count: None,
         corners: Vec::new(),
         faces: 0,
+        vertex_values: channels_of(Side::Vertex),
+        face_values: channels_of(Side::Face),
+        triangle_faces: Vec::new(),
     };
-    let mut seen_vertex = false;
-    let mut seen_face = false;
-    match header.encoding {
-        Encoding::Ascii => {
-            let mut tok = Tokens::new(body, header.body_line);
-            for el in &header.elements {
-                let is_vertex = el.name == b"vertex" && !seen_vertex;
-                let is_face = el.name == b"face" && !seen_face;
-                seen_vertex |= is_vertex;
-                seen_face |= is_face;
-                let roles = roles(el, is_vertex, is_face)?;
-                notes.skipped_properties += skipped(&roles);
-                read_ascii_element(&mut tok, el, &roles, &mut b)?;
-                if is_vertex {
-                    b.vertex_count = Some(b.positions.len());
-                }
-            }
+    let mut tok = Tokens::new(body, header.body_line);
+    let mut cur = Cursor {
+        data: body,
+        pos: 0,
+        base: header.body as u64,
+        big: header.encoding == Encoding::Big,
+    };
+    for ((el, &side), plan) in header.elements.iter().zip(&sides).zip(&plans) {
+        notes.skipped_properties += skipped(&plan.roles);
+        let element = Reading {
+            el,
+            roles: &plan.roles,
+            side,
+        };
+        match header.encoding {
+            Encoding::Ascii => read_ascii_element(&mut tok, &element, &mut b)?,
+            Encoding::Little | Encoding::Big => read_binary_element(&mut cur, &element, &mut b)?,
         }
-        Encoding::Little | Encoding::Big => {
-            let mut cur = Cursor {
-                data: body,
-                pos: 0,
-                base: header.body as u64,
-                big: header.encoding == Encoding::Big,
-            };
-            for el in &header.elements {
-                let is_vertex = el.name == b"vertex" && !seen_vertex;
-                let is_face = el.name == b"face" && !seen_face;
-                seen_vertex |= is_vertex;
-                seen_face |= is_face;
-                let roles = roles(el, is_vertex, is_face)?;
-                notes.skipped_properties += skipped(&roles);
-                read_binary_element(&mut cur, el, &roles, &mut b)?;
-                if is_vertex {
-                    b.vertex_count = Some(b.positions.len());
-                }
-            }
+        if side == Side::Vertex {
+            b.vertex_count = Some(b.positions.len());
         }
     }
-    Ok(IndexedMesh::new(b.positions, b.triangles))
+    let mut channels = Vec::new();
+    for (side, values) in [(Side::Vertex, b.vertex_values), (Side::Face, b.face_values)] {
+        let planned = sides
+            .iter()
+            .zip(&plans)
+            .filter(|(&s, _)| s == side)
+            .flat_map(|(_, p)| &p.channels);
+        for (c, v) in planned.zip(values) {
+            // A vertex channel's value i is vertex i's; a face channel's is face i's.
+            let corners = match side {
+                Side::Vertex => b.triangles.clone(),
+                _ => b.triangle_faces.iter().map(|&f| [f; 3]).collect(),
+            };
+            channels.push(Channel {
+                kind: c.kind,
+                name: c.name.clone(),
+                dimension: c.dimension,
+                values: v.data,
+                corners,
+            });
+        }
+    }
+    Ok(
+        IndexedMesh::new(b.positions, b.triangles).with_attributes(Attributes {
+            channels,
+            ..Attributes::default()
+        }),
+    )
 }
 
 /// How many properties of an element the reader skips.
@@ -418,12 +775,19 @@ fn plural(name: &[u8]) -> String {
     }
 }
 
-fn read_ascii_element<'a>(
-    tok: &mut Tokens<'a>,
-    el: &Element,
-    roles: &[Role],
+/// An element being read: its declaration, its plan's roles, and which it is.
+struct Reading<'e, 'a> {
+    el: &'e Element<'a>,
+    roles: &'e [Role],
+    side: Side,
+}
+
+fn read_ascii_element(
+    tok: &mut Tokens<'_>,
+    reading: &Reading,
     b: &mut Builder,
 ) -> Result<(), ReadError> {
+    let Reading { el, roles, side } = *reading;
     let is_vertex = roles.iter().any(|r| matches!(r, Role::Coord(_)));
     let is_face = roles.iter().any(|r| matches!(r, Role::Indices));
     if is_vertex {
@@ -436,6 +800,7 @@ fn read_ascii_element<'a>(
     }
     let what = plural(el.name);
     for r in 0..el.count {
+        b.start_record(side);
         let mut p = [0.0; 3];
         for (&(name, prop), &role) in el.props.iter().zip(roles) {
             match (prop, role) {
@@ -447,6 +812,40 @@ fn read_ascii_element<'a>(
                             format!("vertex {r}: bad coordinate {}", show(t)),
                         )
                     })?;
+                }
+                (
+                    Prop::Scalar(_),
+                    Role::Value {
+                        channel,
+                        component,
+                        convert,
+                    },
+                ) => {
+                    let t = next_token(tok, r, el.count, &what)?;
+                    let at = Location::Line(tok.line());
+                    let value = match convert {
+                        Convert::Float => parse_f32(t),
+                        Convert::Level(max) => parse_f64(t).map(|v| from_level(v, max)),
+                    }
+                    .ok_or_else(|| {
+                        ReadError::malformed(
+                            at,
+                            format!(
+                                "{} {r}: bad value {} for property \"{}\"",
+                                el.name.escape_ascii(),
+                                show(t),
+                                name.escape_ascii()
+                            ),
+                        )
+                    })?;
+                    b.store(
+                        side,
+                        (channel, component),
+                        value,
+                        (el.name, r, name),
+                        || show(t),
+                        at,
+                    )?;
                 }
                 (Prop::Scalar(_), _) => {
                     next_token(tok, r, el.count, &what)?;
@@ -582,10 +981,10 @@ impl Cursor<'_> {
 
 fn read_binary_element(
     cur: &mut Cursor,
-    el: &Element,
-    roles: &[Role],
+    reading: &Reading,
     b: &mut Builder,
 ) -> Result<(), ReadError> {
+    let Reading { el, roles, side } = *reading;
     let what = plural(el.name);
     let fixed: Option<usize> = el.props.iter().try_fold(0usize, |acc, (_, p)| match p {
         Prop::Scalar(t) => Some(acc + t.size()),
@@ -601,11 +1000,17 @@ fn read_binary_element(
                 format!("after {fits} of {} {what} (binary PLY)", el.count),
             ));
         }
-        if !roles.iter().any(|r| matches!(r, Role::Coord(_))) {
+        if roles.iter().all(|r| matches!(r, Role::Skip)) {
             cur.pos += stride * el.count;
             return Ok(());
         }
-        b.positions.reserve(el.count);
+        // The records fit, and each value takes at least a byte of them.
+        if roles.iter().any(|r| matches!(r, Role::Coord(_))) {
+            b.positions.reserve(el.count);
+        }
+        for v in b.values(side) {
+            v.data.reserve(el.count * v.dimension);
+        }
     }
     let mut has_faces = false;
     for r in 0..el.count {
@@ -616,13 +1021,37 @@ fn read_binary_element(
             )
         };
         let record_at = cur.at();
+        b.start_record(side);
         let mut p = [0.0; 3];
         let mut is_vertex = false;
-        for (&(_, prop), &role) in el.props.iter().zip(roles) {
+        for (&(name, prop), &role) in el.props.iter().zip(roles) {
             match (prop, role) {
                 (Prop::Scalar(ty), Role::Coord(k)) => {
                     p[k] = cur.scalar(ty).ok_or_else(|| truncated(cur))?;
                     is_vertex = true;
+                }
+                (
+                    Prop::Scalar(ty),
+                    Role::Value {
+                        channel,
+                        component,
+                        convert,
+                    },
+                ) => {
+                    let at = cur.at();
+                    let raw = cur.scalar(ty).ok_or_else(|| truncated(cur))?;
+                    let value = match convert {
+                        Convert::Float => raw as f32,
+                        Convert::Level(max) => from_level(raw, max),
+                    };
+                    b.store(
+                        side,
+                        (channel, component),
+                        value,
+                        (el.name, r, name),
+                        || format!("{raw:e}"),
+                        at,
+                    )?;
                 }
                 (Prop::Scalar(ty), _) => {
                     if cur.remaining() < ty.size() {
@@ -677,28 +1106,164 @@ fn read_binary_element(
     Ok(())
 }
 
-pub(crate) fn write(out: &mut impl Write, mesh: &IndexedMesh) -> std::io::Result<()> {
-    write!(
-        out,
-        "ply\nformat binary_little_endian 1.0\ncomment written by qem\n\
-         element vertex {}\nproperty double x\nproperty double y\nproperty double z\n\
-         element face {}\nproperty list uchar int vertex_indices\nend_header\n",
-        mesh.positions.len(),
-        mesh.triangles.len()
-    )?;
-    let mut buf = [0u8; 24];
-    for p in &mesh.positions {
-        for (k, c) in p.iter().enumerate() {
-            buf[8 * k..8 * k + 8].copy_from_slice(&c.to_le_bytes());
-        }
-        out.write_all(&buf)?;
+/// Where the writer puts a channel.
+pub(crate) enum Placement {
+    /// On the vertex element (per vertex, after splitting at seams), as these
+    /// properties.
+    Vertex(Vec<String>),
+    /// On the face element (a face colour), as these properties.
+    Face(Vec<String>),
+    /// Left out, and why.
+    Left(&'static str),
+}
+
+/// Where [`write`] puts each of `channels`: the first texture coordinates as `s t`, the
+/// first normals as `nx ny nz`, the first colour with one value per triangle as the
+/// faces' `red green blue [alpha]` and the first other colour as the vertices',
+/// generic channels under their names (`<name>_0`, `<name>_1`... for vectors), at most
+/// [`MAX_CHANNELS`] in all (what the reader reads back).
+pub(crate) fn placements(channels: &[Channel]) -> Vec<Placement> {
+    let mut used: Vec<String> = Vec::new();
+    let mut kinds: Vec<(ChannelKind, bool)> = Vec::new();
+    let mut count = 0;
+    let colour = |dimension: usize| -> Vec<String> {
+        ["red", "green", "blue", "alpha"][..dimension.min(4)]
+            .iter()
+            .map(|s| s.to_string())
+            .collect()
+    };
+    channels
+        .iter()
+        .map(|c| {
+            let on_face = is_face_colour(c);
+            let taken = kinds.contains(&(c.kind, on_face));
+            let placement = match c.kind {
+                _ if count >= MAX_CHANNELS => {
+                    Placement::Left("qem reads at most 16 channels from a PLY file")
+                }
+                ChannelKind::TexCoord | ChannelKind::Normal if taken => {
+                    Placement::Left("PLY holds one texture coordinate and one normal per vertex")
+                }
+                ChannelKind::Color if taken => {
+                    Placement::Left("PLY holds one vertex colour and one face colour")
+                }
+                ChannelKind::TexCoord => Placement::Vertex(vec!["s".into(), "t".into()]),
+                ChannelKind::Normal => {
+                    Placement::Vertex(vec!["nx".into(), "ny".into(), "nz".into()])
+                }
+                ChannelKind::Color if on_face => Placement::Face(colour(c.dimension)),
+                ChannelKind::Color => Placement::Vertex(colour(c.dimension)),
+                ChannelKind::Generic => {
+                    let names: Vec<String> = if c.dimension == 1 {
+                        vec![c.name.clone()]
+                    } else {
+                        (0..c.dimension)
+                            .map(|k| format!("{}_{k}", c.name))
+                            .collect()
+                    };
+                    if c.name.is_empty() || c.name.bytes().any(|b| b <= b' ' || b == 0x7f) {
+                        Placement::Left("a PLY property name cannot be empty or hold spaces")
+                    } else if names.iter().any(|n| is_reserved(n.as_bytes())) {
+                        Placement::Left("PLY readers give this property name another meaning")
+                    } else if names.iter().any(|n| used.contains(n)) {
+                        Placement::Left("another channel has the same PLY property names")
+                    } else {
+                        used.extend(names.iter().cloned());
+                        Placement::Vertex(names)
+                    }
+                }
+            };
+            if !matches!(placement, Placement::Left(_)) {
+                count += 1;
+                kinds.push((c.kind, on_face));
+            }
+            placement
+        })
+        .collect()
+}
+
+/// A property type the writer uses for a channel.
+fn property_type(c: &Channel) -> (&'static str, usize) {
+    if c.kind == ChannelKind::Color && all_levels(&c.values) {
+        ("uchar", 1)
+    } else {
+        ("float", 4)
     }
-    let mut rec = [0u8; 13];
-    rec[0] = 3;
-    for t in &mesh.triangles {
-        for (k, &i) in t.iter().enumerate() {
+}
+
+/// Appends one value of `c` (`None`: zeros) in the writer's type.
+fn push_value(out: &mut Vec<u8>, c: &Channel, value: Option<&[f32]>) {
+    let uchar = property_type(c).1 == 1;
+    for k in 0..c.dimension {
+        let v = value.map_or(0.0, |v| v[k]);
+        if uchar {
+            out.push(to_level(v));
+        } else {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+}
+
+pub(crate) fn write(out: &mut impl Write, mesh: &IndexedMesh) -> std::io::Result<()> {
+    let placements = placements(&mesh.attributes.channels);
+    let mut vertex_names = Vec::new();
+    let mut vertex_channels = Vec::new();
+    let mut face = None;
+    for (c, p) in mesh.attributes.channels.iter().zip(&placements) {
+        match p {
+            Placement::Vertex(names) => {
+                vertex_names.push(names);
+                vertex_channels.push(c.clone());
+            }
+            Placement::Face(names) => face = Some((c, names)),
+            Placement::Left(_) => {}
+        }
+    }
+    let split = per_vertex(mesh, vertex_channels);
+    let vertex = &split.channels;
+    let mut header = format!(
+        "ply\nformat binary_little_endian 1.0\ncomment written by qem\n\
+         element vertex {}\nproperty double x\nproperty double y\nproperty double z\n",
+        split.positions.len()
+    );
+    for (c, names) in vertex.iter().zip(&vertex_names) {
+        for name in names.iter() {
+            header += &format!("property {} {name}\n", property_type(c).0);
+        }
+    }
+    header += &format!(
+        "element face {}\nproperty list uchar int vertex_indices\n",
+        split.triangles.len()
+    );
+    if let Some((c, names)) = face {
+        for name in names {
+            header += &format!("property {} {name}\n", property_type(c).0);
+        }
+    }
+    header += "end_header\n";
+    out.write_all(header.as_bytes())?;
+    let mut rec = Vec::new();
+    for (v, p) in split.positions.iter().enumerate() {
+        rec.clear();
+        for c in p {
+            rec.extend_from_slice(&c.to_le_bytes());
+        }
+        for c in vertex {
+            // Per vertex after the split: value v is vertex v's.
+            push_value(&mut rec, c, Some(c.value(v as u32)));
+        }
+        out.write_all(&rec)?;
+    }
+    for (t, tri) in split.triangles.iter().enumerate() {
+        rec.clear();
+        rec.push(3);
+        for &i in tri {
             // Indices are < 2^31 in any mesh qem accepts (MAX_ELEMENTS = 2^28).
-            rec[1 + 4 * k..5 + 4 * k].copy_from_slice(&i.to_le_bytes());
+            rec.extend_from_slice(&i.to_le_bytes());
+        }
+        if let Some((c, _)) = face {
+            // The split keeps triangle order, so triangle t is the mesh's triangle t.
+            push_value(&mut rec, c, c.at_corner(t, 0));
         }
         out.write_all(&rec)?;
     }

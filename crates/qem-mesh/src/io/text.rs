@@ -136,6 +136,12 @@ pub(crate) fn parse_f64(tok: &[u8]) -> Option<f64> {
     std::str::from_utf8(tok).ok()?.parse().ok()
 }
 
+/// Parses a decimal number straight to the nearest `f32` (attribute values: rounding
+/// through `f64` first could, rarely, land on the other side of a halfway point).
+pub(crate) fn parse_f32(tok: &[u8]) -> Option<f32> {
+    std::str::from_utf8(tok).ok()?.parse().ok()
+}
+
 /// Parses a decimal integer with an optional sign (no allocation, overflow checked).
 pub(crate) fn parse_i64(tok: &[u8]) -> Option<i64> {
     let (neg, digits) = match tok.split_first()? {

@@ -11,6 +11,8 @@ mod passes_common;
 
 #[cfg(feature = "io")]
 mod attributes_obj;
+#[cfg(feature = "io")]
+mod attributes_ply_off;
 mod attributes_simplify;
 mod bvh_extremes;
 mod cluster;
