@@ -1,8 +1,12 @@
-//! `qem measure A B`: Metro-style distance between two mesh files.
+//! `qem measure A B`: Metro-style distance between two mesh files, and the error of
+//! the attribute channels they share.
 
 use clap::Args;
 use qem_mesh::io::read_path;
-use qem_mesh::measure::{measure, MeasureError, MeasureOptions, Measurement, Which};
+use qem_mesh::attributes::ChannelKind;
+use qem_mesh::measure::{
+    measure, measure_attributes, ChannelError, MeasureError, MeasureOptions, Measurement, Which,
+};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
@@ -60,6 +64,31 @@ struct MeasureJson<'a> {
     triangles_a: usize,
     triangles_b: usize,
     seed: u64,
+    /// Per channel both meshes carry (by name): the difference between B's value and
+    /// A's at the closest point, at B's face samples (UV units; degrees for normals).
+    attributes: Vec<ChannelJson>,
+}
+
+/// One channel's error in `qem measure --json`.
+#[derive(Serialize)]
+struct ChannelJson {
+    channel: String,
+    /// `uv units`, `degrees` or `value units`.
+    units: &'static str,
+    samples: u64,
+    rms: f64,
+    mean: f64,
+    p95: f64,
+    max: f64,
+}
+
+/// The unit of a channel kind's differences.
+fn unit(kind: ChannelKind) -> &'static str {
+    match kind {
+        ChannelKind::TexCoord => "uv units",
+        ChannelKind::Normal => "degrees",
+        ChannelKind::Color | ChannelKind::Generic => "value units",
+    }
 }
 
 /// Runs `qem measure`; the error is the one-line message for stderr.
@@ -76,6 +105,8 @@ pub fn run(args: &MeasureArgs) -> Result<(), String> {
         MeasureError::Invalid { mesh: Which::B, .. } => format!("{}: {e}", args.b.display()),
         _ => format!("{}: {e}", args.a.display()),
     })?;
+    // Both meshes passed validation above, so only the options could be refused.
+    let channels = measure_attributes(&a, &b, &options).map_err(|e| e.to_string())?;
     if args.json {
         let json = MeasureJson {
             a: &args.a,
@@ -94,20 +125,38 @@ pub fn run(args: &MeasureArgs) -> Result<(), String> {
             triangles_a: a.triangle_count(),
             triangles_b: b.triangle_count(),
             seed: args.seed,
+            attributes: channels
+                .iter()
+                .map(|c| ChannelJson {
+                    channel: c.channel.clone(),
+                    units: unit(c.kind),
+                    samples: c.samples,
+                    rms: c.rms,
+                    mean: c.mean,
+                    p95: c.p95,
+                    max: c.max,
+                })
+                .collect(),
         };
         let text = serde_json::to_string_pretty(&json).map_err(|e| format!("JSON: {e}"))?;
         println!("{text}");
     } else {
         print!(
             "{}",
-            human(args, &m, a.triangle_count(), b.triangle_count())
+            human(args, &m, a.triangle_count(), b.triangle_count(), &channels)
         );
     }
     Ok(())
 }
 
 /// One line per figure, distances in % of A's diagonal.
-fn human(args: &MeasureArgs, m: &Measurement, tris_a: usize, tris_b: usize) -> String {
+fn human(
+    args: &MeasureArgs,
+    m: &Measurement,
+    tris_a: usize,
+    tris_b: usize,
+    channels: &[ChannelError],
+) -> String {
     let pct = |v: f64| format!("{:.6} % of diagonal", 100.0 * v);
     let mut s = String::new();
     s += &format!("A: {} ({tris_a} triangles)\n", args.a.display());
@@ -124,5 +173,17 @@ fn human(args: &MeasureArgs, m: &Measurement, tris_a: usize, tris_b: usize) -> S
         "samples:        {} on A, {} on B (seed {})\n",
         m.samples_ab, m.samples_ba, args.seed
     );
+    for c in channels {
+        s += &format!(
+            "{}: p95 {:.6}, mean {:.6}, RMS {:.6}, max {:.6} ({}; {} samples on B)\n",
+            c.channel,
+            c.p95,
+            c.mean,
+            c.rms,
+            c.max,
+            unit(c.kind),
+            c.samples
+        );
+    }
     s
 }
