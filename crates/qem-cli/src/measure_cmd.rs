@@ -2,8 +2,8 @@
 //! the attribute channels they share.
 
 use clap::Args;
-use qem_mesh::io::read_path;
 use qem_mesh::attributes::ChannelKind;
+use qem_mesh::io::read_path;
 use qem_mesh::measure::{
     measure, measure_attributes, ChannelError, MeasureError, MeasureOptions, Measurement, Which,
 };

@@ -4,6 +4,7 @@
 //! position, every check, the orientation check and its waiver, the contraction
 //! itself, the counters and the observer's event.
 
+use super::super::wedges::Pin;
 use super::*;
 
 impl Engine {
@@ -151,12 +152,16 @@ impl Engine {
         if error > self.settings.max_error_bound {
             return Attempt::OverErrorBound;
         }
-        let world = self.world_position(a, &placed, any_locked);
-        let seam = self
-            .wedges
-            .as_ref()
-            .map_or(Ok(()), |w| w.pairing(a, b, &around[0]).map(|_| ()));
-        if let Err(why) = seam.and_then(|()| self.check(a, b, world, shared, around, merged)) {
+        let plan = self.wedges.as_ref().map_or(Ok(Pin::Free), |w| {
+            w.plan(a, b, &around[0], &around[1]).map(|(_, pin)| pin)
+        });
+        // A seam's pinned end is kept in place bit for bit, as a locked one is.
+        let world = match plan {
+            Ok(Pin::B) if !any_locked => DVec3::from_array(self.world[b as usize]),
+            Ok(Pin::A) => DVec3::from_array(self.world[a as usize]),
+            _ => self.world_position(a, &placed, any_locked),
+        };
+        if let Err(why) = plan.and_then(|_| self.check(a, b, world, shared, around, merged)) {
             self.counters.reject(why);
             return Attempt::Refused;
         }

@@ -39,7 +39,7 @@ use super::relaxation::Ladder;
 use super::report::StopReason;
 use super::settings::Settings;
 use super::waivers::{penalised, Waivers};
-use super::wedges::Wedges;
+use super::wedges::{Pin, Wedges};
 use crate::inspect::{find, union};
 use crate::pairs::grid::{virtual_pairs, GridOptions};
 use crate::store::build::kept_triangles;
@@ -59,6 +59,11 @@ pub(super) fn ranked(cost: f64) -> f64 {
         cost
     }
 }
+
+/// The geometric error (as a squared distance in the normalised frame, times the
+/// quadric's weight) an attribute-weighted placement may always add: 1e-4 of the
+/// frame's half-size, squared.
+const GEOMETRY_SLACK: f64 = 1e-8;
 
 /// How often (in attempted contractions) the observer's progress is called.
 const OBSERVER_INTERVAL: usize = 4096;
@@ -702,7 +707,7 @@ impl Engine {
     /// geometric and the attribute error together, and a pair that would join a
     /// seam's sides costs +∞); the quadric returned is the geometric one.
     fn place_with(&self, a: u32, b: u32, q: Quadric) -> (Placement, Quadric) {
-        let ends = [
+        let mut ends = [
             (self.position[a as usize], self.locked[a as usize]),
             (self.position[b as usize], self.locked[b as usize]),
         ];
@@ -710,10 +715,29 @@ impl Engine {
             return (place_merged(&q, ends, self.settings.placement), q);
         };
         match wedges.merged_error(&self.incidence, &self.triangles, a, b) {
-            Some(attributes) => (
-                place_merged(&(q + attributes), ends, self.settings.placement),
-                q,
-            ),
+            Some((attributes, pin)) => {
+                // A pinned end is placed like a locked one.
+                match pin {
+                    Pin::Free => {}
+                    Pin::A => ends[0].1 = true,
+                    Pin::B => ends[1].1 = true,
+                }
+                let total = q + attributes;
+                let both = place_merged(&total, ends, self.settings.placement);
+                // Where the attributes would pull the vertex off the geometry's best
+                // place by more than half its error again, the geometry's place wins
+                // (meshoptimizer's update rule has the same bound, 1.5x): attribute
+                // fields that bend faster than the surface (smooth normals across a
+                // crease) would otherwise trade shape for shading.
+                let geometric = place_merged(&q, ends, self.settings.placement);
+                let allowed = 1.5 * geometric.cost + GEOMETRY_SLACK * q.weight();
+                if q.evaluate(both.position) <= allowed {
+                    (both, q)
+                } else {
+                    let cost = total.evaluate(geometric.position).max(0.0);
+                    (Placement { cost, ..geometric }, q)
+                }
+            }
             None => {
                 let mut placed = place_merged(&q, ends, self.settings.placement);
                 placed.cost = f64::INFINITY;

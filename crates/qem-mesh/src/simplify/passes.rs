@@ -562,8 +562,11 @@ impl Engine {
         }
         // Not where merges are allowed: a merge removes a face on both ends of a pair
         // of the same round, which changes that pair's exact quadric.
+        // Nor with attributes: a seam may pin the merged vertex at either end, which
+        // the speculated placement does not know.
         self.input_surface.is_some()
             && !self.settings.allow_merges
+            && self.wedges.is_none()
             && self.chunk_contracted * 2 >= self.chunk_attempted
     }
 

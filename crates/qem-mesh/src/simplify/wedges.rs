@@ -61,6 +61,19 @@ pub(super) struct Wedges {
 /// wedge of `a`).
 pub(super) type Pairing = SmallVec<[(u32, u32); 4]>;
 
+/// Where a contraction may put the merged vertex, for the seams' sake.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Pin {
+    /// Anywhere: every wedge of both ends pairs (an interior edge, or a seam edge
+    /// contracted along its seam with both sides).
+    Free,
+    /// At `a`: `a` has a wedge the pairing leaves alone (it lies on a seam that `b`
+    /// is not on), whose values would be extrapolated off its chart if `a` moved.
+    A,
+    /// At `b`, for the same reason.
+    B,
+}
+
 impl Wedges {
     /// The wedges of the engine's triangles `triangles` (engine numbering, each from
     /// the cleaned triangle `triangle_from[t]`), positions `position` (normalised),
@@ -184,18 +197,58 @@ impl Wedges {
         Ok(pairs)
     }
 
+    /// The pairing of contracting `b` into `a` and where the merged vertex may go
+    /// ([`Pin`]): a vertex with a wedge the pairing leaves alone stays where it is (so
+    /// a seam vertex moves only along its seam, and no chart's values are
+    /// extrapolated past its border, as meshoptimizer's seam rule keeps them); when
+    /// both ends have such a wedge neither can stay for the other and the place is
+    /// free. A virtual pair (no triangle on both) pairs nothing and keeps `a`'s place.
+    pub fn plan(
+        &self,
+        a: u32,
+        b: u32,
+        around_a: &[Around],
+        around_b: &[Around],
+    ) -> Result<(Pairing, Pin), Rejection> {
+        let pairs = self.pairing(a, b, around_a)?;
+        if pairs.is_empty() {
+            return Ok((pairs, Pin::A));
+        }
+        let left_alone = |around: &[Around], v: u32, paired: &dyn Fn(u32) -> bool| {
+            around
+                .iter()
+                .filter_map(|x| self.at(x.triangle, x.corners, v))
+                .any(|w| !paired(w))
+        };
+        let a_alone = left_alone(around_a, a, &|w| pairs.iter().any(|&(_, pa)| pa == w));
+        let b_alone = left_alone(around_b, b, &|w| pairs.iter().any(|&(pb, _)| pb == w));
+        let pin = match (a_alone, b_alone) {
+            (false, false) => Pin::Free,
+            (true, false) => Pin::A,
+            (false, true) => Pin::B,
+            // Both ends keep a wedge of their own (a vertex where several seams meet,
+            // a face-normal solid's corner): no end can stay for both, and refusing
+            // would leave such meshes stuck (per-face normals make every edge this
+            // way). The one-to-one pairing still keeps each side's values apart.
+            (true, true) => Pin::Free,
+        };
+        Ok((pairs, pin))
+    }
+
     /// The attribute error of contracting `b` into `a`, as a quadric in the merged
-    /// vertex's position: for each wedge the merged vertex would have, the error left
-    /// at its best values. `None` when the pairing is refused.
+    /// vertex's position (for each wedge the merged vertex would have, the error left
+    /// at its best values), and where the vertex may go. `None` when the pair is
+    /// refused ([`Wedges::plan`]).
     pub fn merged_error(
         &self,
         incidence: &Incidence,
         triangles: &[[u32; 3]],
         a: u32,
         b: u32,
-    ) -> Option<Quadric> {
+    ) -> Option<(Quadric, Pin)> {
         let around_a: SmallVec<[Around; 16]> = live_around(incidence, triangles, a).collect();
-        let pairs = self.pairing(a, b, &around_a).ok()?;
+        let around_b: SmallVec<[Around; 16]> = live_around(incidence, triangles, b).collect();
+        let (pairs, pin) = self.plan(a, b, &around_a, &around_b).ok()?;
         let width = self.channels.len();
         let mut seen: SmallVec<[u32; 8]> = SmallVec::new();
         let mut q = Quadric::ZERO;
@@ -221,12 +274,12 @@ impl Wedges {
                 add(wa, partner, &mut seen);
             }
         }
-        for x in live_around(incidence, triangles, b) {
+        for x in &around_b {
             if let Some(wb) = self.at(x.triangle, x.corners, b) {
                 add(wb, None, &mut seen);
             }
         }
-        Some(q)
+        Some((q, pin))
     }
 
     /// Records the contraction of `b` into `a`, with `around` the live triangles of

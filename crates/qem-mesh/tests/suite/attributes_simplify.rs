@@ -240,3 +240,86 @@ fn positions_only_input_is_simplified_as_before() {
     assert_eq!(out.mesh.positions, plain.mesh.positions);
     assert_eq!(out.mesh.triangles, plain.mesh.triangles);
 }
+
+/// A UV sphere of radius 1 with `rings` × `segments` quads (the poles as fans).
+fn sphere(rings: u32, segments: u32) -> IndexedMesh {
+    let mut positions = vec![[0.0, 0.0, 1.0]];
+    for r in 1..rings {
+        let theta = std::f64::consts::PI * f64::from(r) / f64::from(rings);
+        for s in 0..segments {
+            let phi = 2.0 * std::f64::consts::PI * f64::from(s) / f64::from(segments);
+            positions.push([
+                theta.sin() * phi.cos(),
+                theta.sin() * phi.sin(),
+                theta.cos(),
+            ]);
+        }
+    }
+    positions.push([0.0, 0.0, -1.0]);
+    let last = positions.len() as u32 - 1;
+    let at = |r: u32, s: u32| 1 + (r - 1) * segments + s % segments;
+    let mut triangles = Vec::new();
+    for s in 0..segments {
+        triangles.push([0, at(1, s), at(1, s + 1)]);
+        triangles.push([last, at(rings - 1, s + 1), at(rings - 1, s)]);
+    }
+    for r in 1..rings - 1 {
+        for s in 0..segments {
+            let (a, b, c, d) = (at(r, s), at(r, s + 1), at(r + 1, s), at(r + 1, s + 1));
+            triangles.push([a, c, d]);
+            triangles.push([a, d, b]);
+        }
+    }
+    IndexedMesh::new(positions, triangles)
+}
+
+#[test]
+fn smooth_normals_on_a_sphere_follow_the_surface_and_cost_little_geometry() {
+    // On a sphere the exact normal is the position: a field the quadric holds well.
+    let mut mesh = sphere(40, 80);
+    let normal = per_vertex(&mesh, ChannelKind::Normal, |p| {
+        p.iter().map(|&c| c as f32).collect()
+    });
+    mesh.attributes.channels.push(normal);
+    let options = SimplifyOptions::DEFAULT.with_target(Target::Ratio(0.1));
+    let out = simplify(&mesh, &options).unwrap();
+    let plain = simplify(
+        &IndexedMesh::new(mesh.positions.clone(), mesh.triangles.clone()),
+        &options,
+    )
+    .unwrap();
+    let m = &out.mesh;
+    let normals = m.attributes.channel(ChannelKind::Normal).unwrap();
+    let mut worst: f64 = 0.0;
+    for (t, tri) in m.triangles.iter().enumerate() {
+        for (k, &v) in tri.iter().enumerate() {
+            let p = m.positions[v as usize];
+            let l = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+            let n = normals.at_corner(t, k).unwrap();
+            let dot: f64 = (0..3).map(|i| f64::from(n[i]) * p[i] / l).sum();
+            worst = worst.max(dot.clamp(-1.0, 1.0).acos().to_degrees());
+        }
+    }
+    assert!(
+        worst < 2.0,
+        "a normal is {worst}° off its position's direction"
+    );
+    let measure = |x: &IndexedMesh| {
+        qem_mesh::measure::measure(
+            &mesh,
+            x,
+            &qem_mesh::measure::MeasureOptions {
+                min_samples: 100_000,
+                ..qem_mesh::measure::MeasureOptions::DEFAULT
+            },
+        )
+        .unwrap()
+    };
+    let (with, without) = (measure(m), measure(&plain.mesh));
+    assert!(
+        with.mean_ab < 1.1 * without.mean_ab,
+        "mean {} with normals, {} without",
+        with.mean_ab,
+        without.mean_ab
+    );
+}
