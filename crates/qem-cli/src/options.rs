@@ -4,9 +4,10 @@
 
 use crate::failure::Failure;
 use clap::{Args, ValueEnum};
+use qem_mesh::attributes::ChannelKind;
 use qem_mesh::simplify::{
-    BoundaryMode, ContractionOrder, Length, Method, QuadricMode, SimplifyOptions, Target,
-    VirtualPairs, Weighting, DEFAULT_BOUNDARY_WEIGHT, DEFAULT_MAX_NORMAL_ANGLE,
+    AttributeWeights, BoundaryMode, ContractionOrder, Length, Method, QuadricMode, SimplifyOptions,
+    Target, VirtualPairs, Weighting, DEFAULT_BOUNDARY_WEIGHT, DEFAULT_MAX_NORMAL_ANGLE,
     DEFAULT_MIN_TRIANGLE_QUALITY,
 };
 use std::path::{Path, PathBuf};
@@ -149,6 +150,36 @@ pub struct SimplifyFlags {
     /// in which faces first use them [default: none].
     #[arg(long, value_name = "FILE")]
     pub lock: Option<PathBuf>,
+    /// How much texture coordinates, normals, colours and other channels weigh against
+    /// positions, as `kind=weight` pairs separated by commas (kinds: uv, normal,
+    /// colour, generic; the others keep their defaults); 0 leaves a channel out of the
+    /// cost (its values still follow the vertices) [default: uv=0.3,normal=0.15,
+    /// colour=1,generic=1].
+    #[arg(long, value_name = "KIND=W,...", value_parser = parse_attribute_weights)]
+    pub attribute_weights: Option<AttributeWeights>,
+}
+
+/// Parses `--attribute-weights`: `uv=1,normal=0.5`.
+pub fn parse_attribute_weights(s: &str) -> Result<AttributeWeights, String> {
+    let mut weights = AttributeWeights::DEFAULT;
+    for part in s.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+        let (kind, value) = part
+            .split_once('=')
+            .ok_or_else(|| format!("`{part}` is not kind=weight (e.g. uv=0.5)"))?;
+        let kind = match kind.trim() {
+            "uv" => ChannelKind::TexCoord,
+            "normal" => ChannelKind::Normal,
+            "colour" | "color" => ChannelKind::Color,
+            "generic" => ChannelKind::Generic,
+            other => {
+                return Err(format!(
+                    "`{other}` is not a channel kind: use uv, normal, colour or generic"
+                ))
+            }
+        };
+        weights = weights.with(kind, parse_non_negative(value.trim())?);
+    }
+    Ok(weights)
 }
 
 /// Parses a ratio in (0, 1].
@@ -304,7 +335,8 @@ impl SimplifyFlags {
                 Some(OrderFlag::Greedy) => ContractionOrder::Greedy,
                 Some(OrderFlag::Passes) => ContractionOrder::Passes,
                 None => preset.order,
-            });
+            })
+            .with_attribute_weights(self.attribute_weights.unwrap_or(preset.attribute_weights));
         Ok(match &self.lock {
             Some(path) => {
                 options.with_locked_vertices(read_lock_file(path).map_err(Failure::Failed)?)

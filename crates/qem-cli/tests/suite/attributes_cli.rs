@@ -65,3 +65,40 @@ fn stl_output_drops_the_uvs_and_the_report_says_why() {
         "STL holds positions only"
     );
 }
+
+#[test]
+fn attribute_weights_change_the_result_and_bad_ones_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |weights: &str, name: &str| {
+        let out = dir.path().join(name);
+        let o = qem(&[
+            "simplify",
+            spot().to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--ratio",
+            "0.1",
+            "--attribute-weights",
+            weights,
+        ]);
+        (o, out)
+    };
+    let (o, free) = run("uv=0", "free.obj");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (o, heavy) = run("uv=3,normal=1", "heavy.obj");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (free, heavy) = (
+        qem_mesh::io::read_path(&free).unwrap().mesh,
+        qem_mesh::io::read_path(&heavy).unwrap().mesh,
+    );
+    // Weight 0 still carries the values; the weight changes where vertices go.
+    assert!(free.attributes.channel(ChannelKind::TexCoord).is_some());
+    assert_ne!(free.positions, heavy.positions);
+    let (o, _) = run("uvw=1", "bad.obj");
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("`uvw` is not a channel kind"),
+        "{}",
+        stderr(&o)
+    );
+}

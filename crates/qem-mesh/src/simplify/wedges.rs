@@ -138,9 +138,10 @@ impl Wedges {
                 if idx.contains(&Channel::MISSING) {
                     continue;
                 }
-                let w = channel_weights[j];
+                // Unweighted: the weight scales the error (by its square) where the
+                // cost is formed, so a weight of 0 still gives the values.
                 let scaled: [SmallVec<[f64; 4]>; 3] =
-                    idx.map(|i| c.value(i).iter().map(|&x| w * f64::from(x)).collect());
+                    idx.map(|i| c.value(i).iter().map(|&x| f64::from(x)).collect());
                 let mut one = AttributeQuadric::new(c.dimension);
                 one.add_triangle(p, [&scaled[0], &scaled[1], &scaled[2]]);
                 for &wedge in &corner[t] {
@@ -265,7 +266,8 @@ impl Wedges {
                 if let Some(p) = partner {
                     sum += &self.quadric[p as usize * width + j];
                 }
-                q += sum.position_quadric();
+                let w = self.weights[j];
+                q += sum.position_quadric() * (w * w);
             }
         };
         for x in &around_a {
@@ -399,8 +401,7 @@ impl Wedges {
         if !self.touched[wedge as usize] || q.area().is_nan() || q.area() <= 0.0 {
             return Some(channel.value(i).iter().copied().collect());
         }
-        let w = self.weights[j];
-        let mut v: SmallVec<[f64; 4]> = q.values_at(p).iter().map(|x| x / w).collect();
+        let mut v: SmallVec<[f64; 4]> = q.values_at(p);
         match channel.kind {
             ChannelKind::Normal => {
                 let n = DVec3::new(v[0], v[1], v[2]).normalize_or_zero();
