@@ -152,16 +152,24 @@ impl Engine {
         if error > self.settings.max_error_bound {
             return Attempt::OverErrorBound;
         }
-        let plan = self.wedges.as_ref().map_or(Ok(Pin::Free), |w| {
-            w.plan(a, b, &around[0], &around[1]).map(|(_, pin)| pin)
-        });
+        // With attributes, the seams' plan: refused, or which end (if any) must stay.
+        let plan = match self.wedges.as_ref() {
+            Some(w) => match w.plan(a, b, &around[0], &around[1]) {
+                Ok(plan) => Some(plan),
+                Err(why) => {
+                    self.counters.reject(why);
+                    return Attempt::Refused;
+                }
+            },
+            None => None,
+        };
         // A seam's pinned end is kept in place bit for bit, as a locked one is.
-        let world = match plan {
-            Ok(Pin::B) if !any_locked => DVec3::from_array(self.world[b as usize]),
-            Ok(Pin::A) => DVec3::from_array(self.world[a as usize]),
+        let world = match plan.as_ref().map(|p| p.pin) {
+            Some(Pin::B) if !any_locked => DVec3::from_array(self.world[b as usize]),
+            Some(Pin::A) => DVec3::from_array(self.world[a as usize]),
             _ => self.world_position(a, &placed, any_locked),
         };
-        if let Err(why) = plan.and_then(|_| self.check(a, b, world, shared, around, merged)) {
+        if let Err(why) = self.check(a, b, world, shared, around, merged) {
             self.counters.reject(why);
             return Attempt::Refused;
         }
@@ -193,8 +201,8 @@ impl Engine {
         if let Some(pairs) = &mut self.virtual_pairs {
             pairs.contract(a, b, |_, _| {});
         }
-        if let Some(wedges) = &mut self.wedges {
-            wedges.contract(a, b, around);
+        if let (Some(wedges), Some(plan)) = (&mut self.wedges, &plan) {
+            wedges.contract(a, b, around, plan);
         }
         let (mut slab, fixed) = self.split();
         let removed = slab.contract(&fixed, [a, b], world, q, around, merged);
