@@ -2,11 +2,13 @@
 //! the attribute channels they share.
 
 use clap::Args;
-use qem_mesh::attributes::ChannelKind;
-use qem_mesh::io::read_path;
+use qem_mesh::attributes::{Channel, ChannelKind};
+use qem_mesh::io::{read_path, write_path_commented, Format};
 use qem_mesh::measure::{
-    measure, measure_attributes, ChannelError, MeasureError, MeasureOptions, Measurement, Which,
+    measure, measure_attributes, vertex_distances, ChannelError, MeasureError, MeasureOptions,
+    Measurement, Which,
 };
+use qem_mesh::IndexedMesh;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
@@ -32,6 +34,77 @@ pub struct MeasureArgs {
     /// Seed of the sampling; the same seed gives the same figures to the bit.
     #[arg(long, default_value_t = MeasureOptions::DEFAULT.seed)]
     pub seed: u64,
+    /// Also write B coloured by each vertex's distance to A (blue: 0, red: the largest),
+    /// with the scale in the file's comments and on stderr; the format follows the
+    /// extension (.ply or .off hold vertex colours).
+    #[arg(long, value_name = "OUT")]
+    pub heatmap: Option<PathBuf>,
+}
+
+/// A colour for `t` in 0..=1: blue, cyan, green, yellow, red (four linear steps).
+fn heat(t: f64) -> [f32; 3] {
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        1.0
+    };
+    let stops = [
+        [0.0, 0.0, 1.0],
+        [0.0, 1.0, 1.0],
+        [0.0, 1.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [1.0, 0.0, 0.0],
+    ];
+    let x = t * 4.0;
+    let i = (x.floor() as usize).min(3);
+    let f = x - i as f64;
+    // On the 0–255 levels, so that PLY holds them as `uchar` (what every viewer reads).
+    std::array::from_fn(|k| {
+        let c = stops[i][k] * (1.0 - f) + stops[i + 1][k] * f;
+        ((c * 255.0).round() / 255.0) as f32
+    })
+}
+
+/// Writes the heat map of `b` against `a` to `out` (see [`MeasureArgs::heatmap`]).
+fn write_heatmap(
+    args: &MeasureArgs,
+    a: &IndexedMesh,
+    b: &IndexedMesh,
+    out: &Path,
+) -> Result<(), String> {
+    let format = Format::from_path(out).map_err(|e| format!("{}: {e}", out.display()))?;
+    if !matches!(format, Format::Ply | Format::Off) {
+        return Err(format!(
+            "{}: a heat map needs a format with vertex colours: use .ply or .off",
+            out.display()
+        ));
+    }
+    let distances = vertex_distances(a, b).map_err(|e| e.to_string())?;
+    let largest = distances.iter().copied().fold(0.0, f64::max);
+    let values = distances
+        .iter()
+        .flat_map(|&d| heat(if largest > 0.0 { d / largest } else { 0.0 }))
+        .collect();
+    let mut map = IndexedMesh::new(b.positions.clone(), b.triangles.clone());
+    map.attributes.channels.push(Channel::new(
+        ChannelKind::Color,
+        values,
+        b.triangles.clone(),
+    ));
+    let diagonal = a.bounding_box().map_or(0.0, |(lo, hi)| {
+        (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt()
+    });
+    let scale = format!(
+        "heat map of {} against {}: vertex colour = distance to A, blue 0 to red {:.6}% of \
+         A's bounding-box diagonal ({} model units)",
+        args.b.display(),
+        args.a.display(),
+        100.0 * largest,
+        largest * diagonal
+    );
+    write_path_commented(out, &map, std::slice::from_ref(&scale)).map_err(|e| e.to_string())?;
+    eprintln!("{}: {scale}", out.display());
+    Ok(())
 }
 
 fn parse_samples_per_face(s: &str) -> Result<f64, String> {
@@ -107,6 +180,9 @@ pub fn run(args: &MeasureArgs) -> Result<(), String> {
     })?;
     // Both meshes passed validation above, so only the options could be refused.
     let channels = measure_attributes(&a, &b, &options).map_err(|e| e.to_string())?;
+    if let Some(out) = &args.heatmap {
+        write_heatmap(args, &a, &b, out)?;
+    }
     if args.json {
         let json = MeasureJson {
             a: &args.a,

@@ -207,6 +207,56 @@ pub fn measure(
     })
 }
 
+/// The distance from each vertex of `b` to the surface of `a`, as a fraction of `a`'s
+/// bounding-box diagonal (a vertex no triangle of `b` uses gets 0): what a heat map of
+/// `b` shows. Fails as [`measure`] does.
+///
+/// ```
+/// use qem_mesh::IndexedMesh;
+/// use qem_mesh::measure::vertex_distances;
+/// let square = |z: f64| IndexedMesh::new(
+///     vec![[0.0, 0.0, z], [1.0, 0.0, z], [1.0, 1.0, z], [0.0, 1.0, z]],
+///     vec![[0, 1, 2], [0, 2, 3]],
+/// );
+/// let d = vertex_distances(&square(0.0), &square(0.5)).unwrap();
+/// assert!(d.iter().all(|&x| (x - 0.5 / 2f64.sqrt()).abs() < 1e-12));
+/// ```
+pub fn vertex_distances(a: &IndexedMesh, b: &IndexedMesh) -> Result<Vec<f64>, MeasureError> {
+    a.validate().map_err(|error| MeasureError::Invalid {
+        mesh: Which::A,
+        error,
+    })?;
+    b.validate().map_err(|error| MeasureError::Invalid {
+        mesh: Which::B,
+        error,
+    })?;
+    let diagonal = match a.bounding_box() {
+        Some((lo, hi)) => length(sub(hi, lo)),
+        None => 0.0,
+    };
+    if diagonal.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        return Err(MeasureError::ZeroDiagonal);
+    }
+    let mut used = vec![false; b.positions.len()];
+    for t in &b.triangles {
+        for &i in t {
+            used[i as usize] = true;
+        }
+    }
+    let index = TriangleBvh::new(a);
+    Ok(b.positions
+        .par_iter()
+        .zip(&used)
+        .map(|(&p, &used)| {
+            if used {
+                index.distance(p).unwrap_or(0.0) / diagonal
+            } else {
+                0.0
+            }
+        })
+        .collect())
+}
+
 // ----------------------------------------------------------------------------- geometry
 
 type P3 = [f64; 3];

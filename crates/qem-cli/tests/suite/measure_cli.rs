@@ -122,3 +122,65 @@ fn usage_errors_exit_with_2() {
     let o = qem(&["measure", "a.obj", "b.obj", "--samples-per-face", "-1"]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
 }
+
+#[test]
+fn attribute_error_and_heat_map() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let simplified = dir.path().join("s.obj");
+    let o = qem(&[
+        "simplify",
+        spot().to_str().expect("UTF-8 path"),
+        "-o",
+        simplified.to_str().expect("UTF-8 path"),
+        "--ratio",
+        "0.05",
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let heat = dir.path().join("heat.ply");
+    let json = measure_json(
+        &spot(),
+        &simplified,
+        &["--heatmap", heat.to_str().expect("UTF-8 path")],
+    );
+    let uv = &json["attributes"][0];
+    assert_eq!(uv["channel"], "uv");
+    assert_eq!(uv["units"], "uv units");
+    let (p95, max) = (uv["p95"].as_f64().unwrap(), uv["max"].as_f64().unwrap());
+    assert!(0.0 < p95 && p95 <= max, "{uv}");
+    // The heat map: the simplified mesh, coloured per vertex from blue to red.
+    let map = qem_mesh::io::read_path(&heat)
+        .expect("the heat map loads")
+        .mesh;
+    let back = qem_mesh::io::read_path(&simplified).expect("loads").mesh;
+    assert_eq!(map.triangle_count(), back.triangle_count());
+    let colours = map
+        .attributes
+        .channel(qem_mesh::attributes::ChannelKind::Color)
+        .expect("vertex colours");
+    let reddest = colours
+        .values
+        .chunks_exact(3)
+        .map(|c| c[0])
+        .fold(0.0, f32::max);
+    let bluest = colours
+        .values
+        .chunks_exact(3)
+        .map(|c| c[2])
+        .fold(0.0, f32::max);
+    assert!(
+        reddest == 1.0 && bluest == 1.0,
+        "red {reddest}, blue {bluest}"
+    );
+    let text = std::fs::read(&heat).expect("read");
+    let header = String::from_utf8_lossy(&text[..text.len().min(600)]).into_owned();
+    assert!(header.contains("comment heat map of"), "{header}");
+    assert!(stderr(&qem(&[
+        "measure",
+        spot().to_str().unwrap(),
+        simplified.to_str().unwrap(),
+        "--heatmap",
+        dir.path().join("h.stl").to_str().unwrap(),
+    ]))
+    .contains("use .ply or .off"));
+}

@@ -458,6 +458,18 @@ pub fn unwritable(attributes: &crate::attributes::Attributes, format: Format) ->
 /// them), or an STL coordinate beyond float32, is an `InvalidInput` error; nothing else
 /// about the mesh is checked.
 pub fn write_to<W: Write>(out: W, mesh: &IndexedMesh, format: Format) -> std::io::Result<()> {
+    write_commented(out, mesh, format, &[])
+}
+
+/// [`write_to`] with `comments` in the file's header (one line each; a line break in
+/// one becomes a space): PLY `comment` lines, OBJ and OFF `#` lines. STL has no place
+/// for them, and they are left out.
+pub fn write_commented<W: Write>(
+    out: W,
+    mesh: &IndexedMesh,
+    format: Format,
+    comments: &[String],
+) -> std::io::Result<()> {
     // The writers index channels by triangle and corner: checked here, so a malformed
     // channel is an error rather than a panic.
     if let Err(e) = mesh.attributes.validate(mesh.triangles.len()) {
@@ -480,10 +492,10 @@ pub fn write_to<W: Write>(out: W, mesh: &IndexedMesh, format: Format) -> std::io
     }
     let mut out = std::io::BufWriter::with_capacity(1 << 16, out);
     match format {
-        Format::Obj => obj::write(&mut out, mesh)?,
-        Format::Ply => ply::write(&mut out, mesh)?,
+        Format::Obj => obj::write(&mut out, mesh, comments)?,
+        Format::Ply => ply::write(&mut out, mesh, comments)?,
         Format::Stl => stl::write(&mut out, mesh)?,
-        Format::Off => off::write(&mut out, mesh)?,
+        Format::Off => off::write(&mut out, mesh, comments)?,
     }
     out.flush()
 }
@@ -496,6 +508,20 @@ pub fn write_to<W: Write>(out: W, mesh: &IndexedMesh, format: Format) -> std::io
 /// `path` either keeps its old content or gets the complete new one
 /// ([`write_atomically`]).
 pub fn write_path(path: &Path, mesh: &IndexedMesh) -> Result<(), IoError> {
+    write_path_commented(path, mesh, &[])
+}
+
+/// A comment as one line: line breaks become spaces.
+pub(crate) fn one_line(comment: &str) -> String {
+    comment.replace(['\r', '\n'], " ")
+}
+
+/// [`write_path`] with `comments` in the file's header (see [`write_commented`]).
+pub fn write_path_commented(
+    path: &Path,
+    mesh: &IndexedMesh,
+    comments: &[String],
+) -> Result<(), IoError> {
     let format = Format::from_path(path).map_err(|source| IoError::Read {
         path: path.to_path_buf(),
         source,
@@ -507,11 +533,11 @@ pub fn write_path(path: &Path, mesh: &IndexedMesh) -> Result<(), IoError> {
     write_atomically(path, |file| {
         if gz {
             let mut enc = flate2::write::GzEncoder::new(file, flate2::Compression::default());
-            write_to(&mut enc, mesh, format)?;
+            write_commented(&mut enc, mesh, format, comments)?;
             enc.finish()?;
             Ok(())
         } else {
-            write_to(file, mesh, format)
+            write_commented(file, mesh, format, comments)
         }
     })
 }

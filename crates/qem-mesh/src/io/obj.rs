@@ -713,8 +713,15 @@ fn push_corners(dst: &mut Vec<[u32; 3]>, src: &[u32], base: u32, ntri: usize) {
     }
 }
 
-pub(crate) fn write(out: &mut impl Write, mesh: &IndexedMesh) -> std::io::Result<()> {
+pub(crate) fn write(
+    out: &mut impl Write,
+    mesh: &IndexedMesh,
+    comments: &[String],
+) -> std::io::Result<()> {
     writeln!(out, "# written by qem")?;
+    for c in comments {
+        writeln!(out, "# {}", super::one_line(c))?;
+    }
     writeln!(
         out,
         "# {} vertices, {} triangles",

@@ -414,7 +414,11 @@ fn write_values(out: &mut impl Write, values: &[f32], clamp: bool) -> std::io::R
     Ok(())
 }
 
-pub(crate) fn write(out: &mut impl Write, mesh: &IndexedMesh) -> std::io::Result<()> {
+pub(crate) fn write(
+    out: &mut impl Write,
+    mesh: &IndexedMesh,
+    comments: &[String],
+) -> std::io::Result<()> {
     let slots = slots(&mesh.attributes.channels);
     let mut vertex = Vec::new();
     let mut face = None;
@@ -437,6 +441,9 @@ pub(crate) fn write(out: &mut impl Write, mesh: &IndexedMesh) -> std::io::Result
     let n = if normal.is_some() { "N" } else { "" };
     writeln!(out, "{st}{c}{n}OFF")?;
     writeln!(out, "# written by qem")?;
+    for c in comments {
+        writeln!(out, "# {}", super::one_line(c))?;
+    }
     writeln!(out, "{} {} 0", split.positions.len(), split.triangles.len())?;
     for (v, [x, y, z]) in split.positions.iter().enumerate() {
         write!(out, "{x} {y} {z}")?;

@@ -1204,7 +1204,11 @@ fn push_value(out: &mut Vec<u8>, c: &Channel, value: Option<&[f32]>) {
     }
 }
 
-pub(crate) fn write(out: &mut impl Write, mesh: &IndexedMesh) -> std::io::Result<()> {
+pub(crate) fn write(
+    out: &mut impl Write,
+    mesh: &IndexedMesh,
+    comments: &[String],
+) -> std::io::Result<()> {
     let placements = placements(&mesh.attributes.channels);
     let mut vertex_names = Vec::new();
     let mut vertex_channels = Vec::new();
@@ -1221,9 +1225,12 @@ pub(crate) fn write(out: &mut impl Write, mesh: &IndexedMesh) -> std::io::Result
     }
     let split = per_vertex(mesh, vertex_channels);
     let vertex = &split.channels;
-    let mut header = format!(
-        "ply\nformat binary_little_endian 1.0\ncomment written by qem\n\
-         element vertex {}\nproperty double x\nproperty double y\nproperty double z\n",
+    let mut header = "ply\nformat binary_little_endian 1.0\ncomment written by qem\n".to_string();
+    for c in comments {
+        header += &format!("comment {}\n", super::one_line(c));
+    }
+    header += &format!(
+        "element vertex {}\nproperty double x\nproperty double y\nproperty double z\n",
         split.positions.len()
     );
     for (c, names) in vertex.iter().zip(&vertex_names) {
