@@ -25,15 +25,16 @@
 //!
 //! ```text
 //! cargo bench -p qem-bench --bench attributes -- --ratios 0.5,0.1,0.01 --runs 3 \
-//!     [--input FILE]... [--uv-weight 1] [--normal-weight 0.5]
+//!     [--input FILE]... [--uv-weight 0.3] [--normal-weight 0.15] [--endpoints]
 //! ```
-//! Without `--input`, the corpus's attributed meshes (`$QEM_CORPUS` or
+//! `--endpoints` places qem's merged vertex at an end or the midpoint (for both of its
+//! runs) instead of the optimum. Without `--input`, the corpus's attributed meshes (`$QEM_CORPUS` or
 //! `../shared/corpus`; skipped with a message when absent).
 
 use qem_mesh::attributes::{split_at_seams, Attributes, Channel, ChannelKind};
 use qem_mesh::clean::{clean, CleanOptions};
 use qem_mesh::measure::{measure, measure_attributes, MeasureOptions};
-use qem_mesh::simplify::{simplify, AttributeWeights, SimplifyOptions, Target};
+use qem_mesh::simplify::{simplify, AttributeWeights, PlacementMode, SimplifyOptions, Target};
 use qem_mesh::IndexedMesh;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -54,6 +55,8 @@ struct Args {
     runs: usize,
     uv_weight: f32,
     normal_weight: f32,
+    /// `--endpoints`: qem places the merged vertex at an end or the midpoint.
+    endpoints: bool,
 }
 
 fn parse_args() -> Result<Args, String> {
@@ -63,6 +66,7 @@ fn parse_args() -> Result<Args, String> {
         runs: 3,
         uv_weight: AttributeWeights::DEFAULT.uv as f32,
         normal_weight: AttributeWeights::DEFAULT.normal as f32,
+        endpoints: false,
     };
     let mut it = std::env::args().skip(1);
     while let Some(a) = it.next() {
@@ -78,6 +82,7 @@ fn parse_args() -> Result<Args, String> {
             "--runs" => args.runs = value()?.parse().map_err(|_| "bad --runs".to_string())?,
             "--uv-weight" => args.uv_weight = value()?.parse().map_err(|_| "bad weight")?,
             "--normal-weight" => args.normal_weight = value()?.parse().map_err(|_| "bad weight")?,
+            "--endpoints" => args.endpoints = true,
             "--bench" => {}
             other => return Err(format!("unknown argument {other}")),
         }
@@ -240,9 +245,12 @@ fn run() -> Result<(), String> {
         let positions_only = IndexedMesh::new(mesh.positions.clone(), mesh.triangles.clone());
         for &ratio in &args.ratios {
             let target = (ratio * mesh.triangle_count() as f64).floor() as usize;
-            let options = SimplifyOptions::DEFAULT
+            let mut options = SimplifyOptions::DEFAULT
                 .with_target(Target::Triangles(target))
                 .with_attribute_weights(weights_qem);
+            if args.endpoints {
+                options = options.with_placement(PlacementMode::EndpointOrMidpoint);
+            }
             let (mut t_qem, mut t_plain, mut t_meshopt) = (Vec::new(), Vec::new(), Vec::new());
             let (mut qem_out, mut plain_out, mut meshopt_out) = (None, None, None);
             for _ in 0..args.runs.max(1) {
