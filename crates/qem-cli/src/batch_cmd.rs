@@ -36,6 +36,10 @@ pub enum FormatArg {
     Stl,
     /// OFF (text).
     Off,
+    /// glTF 2.0 JSON with its buffer embedded (float32 coordinates).
+    Gltf,
+    /// glTF 2.0 binary (GLB, float32 coordinates).
+    Glb,
 }
 
 impl From<FormatArg> for Format {
@@ -45,6 +49,8 @@ impl From<FormatArg> for Format {
             FormatArg::Ply => Format::Ply,
             FormatArg::Stl => Format::Stl,
             FormatArg::Off => Format::Off,
+            FormatArg::Gltf => Format::Gltf,
+            FormatArg::Glb => Format::Glb,
         }
     }
 }
@@ -52,8 +58,8 @@ impl From<FormatArg> for Format {
 /// Arguments of `qem batch`.
 #[derive(Args, Debug)]
 pub struct BatchArgs {
-    /// Input files, directories (walked recursively for .obj .ply .stl .off, optionally
-    /// .gz) or glob patterns such as 'scans/**/*.ply' (quote them so qem expands them).
+    /// Input files, directories (walked recursively for .obj .ply .stl .off .gltf .glb,
+    /// optionally .gz) or glob patterns such as 'scans/**/*.ply' (quote them so qem expands them).
     #[arg(required = true, value_name = "INPUT")]
     pub inputs: Vec<PathBuf>,
     /// Output directory (created if missing). Each output keeps its input's path

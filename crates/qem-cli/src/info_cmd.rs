@@ -35,7 +35,7 @@ order
 /// Arguments of `qem info`.
 #[derive(Args, Debug)]
 pub struct InfoArgs {
-    /// Input mesh (.obj .ply .stl .off, optionally .gz).
+    /// Input mesh (.obj .ply .stl .off .gltf .glb, optionally .gz).
     pub input: PathBuf,
     /// Print one JSON object (keys as listed below, plus input, bbox_min, bbox_max)
     /// instead of text [default: text].

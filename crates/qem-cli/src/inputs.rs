@@ -4,8 +4,8 @@
 //! - A file is an input whatever its extension (an unsupported one then fails with a
 //!   message that lists the supported extensions); its output keeps its file name.
 //! - A directory is walked recursively (symbolic links followed, loops refused) and
-//!   every file with a supported extension (`.obj .ply .stl .off`, optionally `.gz`)
-//!   is an input; other files (materials, textures, notes) are listed as ignored. The
+//!   every file with a supported extension (`.obj .ply .stl .off .gltf
+//!   .glb`, optionally `.gz`) is an input; other files (materials, textures, notes) are listed as ignored. The
 //!   output keeps the path relative to the directory. The output directory itself is
 //!   never walked, so a second run does not take the first run's outputs as inputs.
 //! - Anything else containing `*`, `?` or `[` is a glob pattern (`**` for any depth);

@@ -19,7 +19,8 @@ mod simplify_cmd;
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
-/// Quadric-error-metric simplification of triangle meshes (OBJ, PLY, STL, OFF; .gz input).
+/// Quadric-error-metric simplification of triangle meshes (OBJ, PLY, STL, OFF, glTF;
+/// .gz input).
 #[derive(Parser, Debug)]
 #[command(name = "qem", version, about, long_about = None)]
 struct Cli {

@@ -50,7 +50,7 @@ pub struct SimplifyJson {
     /// fold-over check is off).
     faces_flipped: usize,
     /// What the reader passed over (issue 33): `skipped_lines`, `skipped_properties`,
-    /// `non_utf8_lines`, `byte_order_mark`.
+    /// `skipped_primitives`, `non_utf8_lines`, `byte_order_mark`.
     read_notes: ReadNotesJson,
     /// The attribute channels and labels of the input that the output file carries,
     /// and those it does not, each with the reason.
@@ -151,6 +151,7 @@ pub struct RelaxationJson {
 pub struct ReadNotesJson {
     skipped_lines: usize,
     skipped_properties: usize,
+    skipped_primitives: usize,
     non_utf8_lines: usize,
     byte_order_mark: bool,
 }
@@ -160,6 +161,7 @@ impl From<ReadNotes> for ReadNotesJson {
         ReadNotesJson {
             skipped_lines: n.skipped_lines,
             skipped_properties: n.skipped_properties,
+            skipped_primitives: n.skipped_primitives,
             non_utf8_lines: n.non_utf8_lines,
             byte_order_mark: n.byte_order_mark,
         }

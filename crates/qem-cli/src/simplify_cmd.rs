@@ -19,10 +19,10 @@ pub const LOD_PLACEHOLDER: &str = "{lod}";
 /// Arguments of `qem simplify`.
 #[derive(Args, Debug)]
 pub struct SimplifyArgs {
-    /// Input mesh (.obj .ply .stl .off, optionally .gz).
+    /// Input mesh (.obj .ply .stl .off .gltf .glb, optionally .gz).
     pub input: PathBuf,
-    /// Output mesh; the format follows the extension (.obj .ply .stl .off, optionally
-    /// .gz). With --lods it must contain {lod}, which becomes the level's index
+    /// Output mesh; the format follows the extension (.obj .ply .stl .off .gltf .glb,
+    /// optionally .gz). With --lods it must contain {lod}, which becomes the level's index
     /// (0, 1, 2, ... in the order of --lods).
     #[arg(short, long)]
     pub output: PathBuf,

@@ -8,7 +8,8 @@
 //! - [`pairs`]: virtual pairs (close vertices that share no edge) from a uniform grid.
 //! - [`simplify`]: the Garland–Heckbert contraction loop, its options and report.
 //! - [`cluster`]: vertex clustering on a grid (fast, any input, topology not kept).
-//! - `io` (feature `io`): readers and writers for OBJ, PLY, STL and OFF, with `.gz`.
+//! - `io` (feature `io`): readers and writers for OBJ, PLY, STL, OFF and glTF
+//!   (`.gltf`, `.glb`), with `.gz`.
 #![forbid(unsafe_code)]
 
 pub mod attributes;

@@ -22,7 +22,7 @@ fn messy_folder(root: &Path) {
     write_path(&root.join("sub/grid.stl"), &bumpy_grid(10, 2)).expect("set up the test files");
     write_path(&root.join("sub/more.off.gz"), &bumpy_grid(8, 3)).expect("set up the test files");
     std::fs::write(root.join("corrupt.ply"), CORRUPT_PLY).expect("set up the test files");
-    std::fs::write(root.join("scene.gltf"), b"{\"asset\": {}}").expect("set up the test files");
+    std::fs::write(root.join("scene.fbx"), b"Kaydara FBX Binary").expect("set up the test files");
     std::fs::write(root.join("spot.mtl"), b"newmtl skin\n").expect("set up the test files");
 }
 
@@ -97,9 +97,9 @@ fn bad_files_are_reported_and_the_rest_succeed() {
     };
     let corrupt = error_of("corrupt.ply").expect("corrupt.ply failed");
     assert!(corrupt.contains("corrupt.ply: line 3:"), "{corrupt}");
-    let gltf = error_of("scene.gltf").expect("scene.gltf failed");
-    assert!(gltf.contains("scene.gltf: unsupported file extension \".gltf\""));
-    assert!(gltf.contains(".obj, .ply"), "the fix is suggested: {gltf}");
+    let fbx = error_of("scene.fbx").expect("scene.fbx failed");
+    assert!(fbx.contains("scene.fbx: unsupported file extension \".fbx\""));
+    assert!(fbx.contains(".obj, .ply"), "the fix is suggested: {fbx}");
     let mtl = error_of("spot.mtl").expect("spot.mtl failed");
     assert!(mtl.contains("unsupported file extension"), "{mtl}");
     for good in ["spot.obj", "grid.ply", "grid.stl", "more.off.gz"] {
@@ -116,7 +116,7 @@ fn bad_files_are_reported_and_the_rest_succeed() {
         .any(|l| l.starts_with("qem: error: ") && l.contains("corrupt.ply")));
     assert!(e
         .lines()
-        .any(|l| l.starts_with("qem: error: ") && l.contains("scene.gltf")));
+        .any(|l| l.starts_with("qem: error: ") && l.contains("scene.fbx")));
 
     // Outputs keep the relative path, in the input's own format, and nothing else is
     // left in the output directory (no temporary files, nothing for failed inputs).
@@ -167,7 +167,7 @@ fn directories_are_walked_for_meshes_only() {
         .map(|v| v.as_str().unwrap())
         .collect();
     assert_eq!(ignored.len(), 2, "{ignored:?}");
-    assert!(ignored[0].ends_with("scene.gltf") && ignored[1].ends_with("spot.mtl"));
+    assert!(ignored[0].ends_with("scene.fbx") && ignored[1].ends_with("spot.mtl"));
     assert_eq!(r["summary"]["succeeded"], 4);
     assert_eq!(r["summary"]["failed"], 1);
     assert_eq!(

@@ -198,6 +198,7 @@ fn latin1_cad_obj_is_simplified_and_its_notes_reported() {
         serde_json::json!({
             "skipped_lines": 2,
             "skipped_properties": 0,
+            "skipped_primitives": 0,
             "non_utf8_lines": 5,
             "byte_order_mark": true
         })

@@ -67,6 +67,13 @@ pub enum ReadErrorKind {
     /// The data parsed but does not form a usable mesh (no triangles, non-finite
     /// coordinate, index out of range).
     Mesh(InputError),
+    /// An external buffer file of a `.gltf` could not be read.
+    BufferFile {
+        /// The file as the glTF names it.
+        uri: String,
+        /// The operating system's error.
+        detail: String,
+    },
     /// The gzip layer is corrupt or decompresses to more than the limit.
     Gzip {
         /// What went wrong.
@@ -179,6 +186,9 @@ impl fmt::Display for ReadErrorKind {
             }
             ReadErrorKind::Mesh(e) => write!(f, "{e}"),
             ReadErrorKind::Gzip { detail } => write!(f, "gzip: {detail}"),
+            ReadErrorKind::BufferFile { uri, detail } => {
+                write!(f, "buffer file {uri:?}: cannot read: {detail}")
+            }
         }
     }
 }

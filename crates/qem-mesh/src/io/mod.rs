@@ -1,4 +1,5 @@
-//! Mesh file readers and writers: OBJ, PLY, STL and OFF, each optionally gzipped.
+//! Mesh file readers and writers: OBJ, PLY, STL, OFF and glTF 2.0 (`.gltf`, `.glb`),
+//! each optionally gzipped.
 //!
 //! # Reading
 //! [`read_path`] picks the format from the file name ([`Format::from_path`]: the
@@ -9,7 +10,9 @@
 //!
 //! Polygons are fan-triangulated from their first corner. Vertices are never welded
 //! or removed by the PLY, STL and OFF readers (an STL facet gives three new vertices);
-//! see [`obj`] for what the OBJ reader (built on `tobj`) does to vertex order.
+//! see [`obj`] for what the OBJ reader (built on `tobj`) does to vertex order, and
+//! [`gltf`] for how glTF scenes, primitives and attributes become one mesh (and what
+//! of a glTF file is not carried through).
 //!
 //! **What `read_*` checks.** The result is a mesh that passes
 //! [`IndexedMesh::validate`]: at least one triangle, counts within
@@ -44,7 +47,8 @@
 //! a format leaves out. STL is binary with `float32` coordinates (the format has no
 //! other choice) and facet normals computed from the triangles; a coordinate beyond
 //! float32's range (about ±3.4e38) is an `InvalidInput` error rather than an infinity
-//! in the file.
+//! in the file. glTF (`.gltf` with its buffer embedded, or `.glb`) also has `float32`
+//! positions; its attributes, materials and groups are described in [`gltf`].
 //!
 //! ```
 //! use qem_mesh::io::{read_bytes, write_to, Format};
@@ -63,6 +67,7 @@
 mod atomic;
 mod channels;
 mod error;
+pub mod gltf;
 pub mod obj;
 mod off;
 mod ply;
@@ -81,7 +86,8 @@ pub use error::{IoError, Location, ReadError, ReadErrorKind};
 use crate::IndexedMesh;
 
 /// The extensions [`Format::from_path`] accepts, as shown in error messages.
-pub const SUPPORTED_EXTENSIONS: &str = ".obj, .ply, .stl, .off (each optionally followed by .gz)";
+pub const SUPPORTED_EXTENSIONS: &str =
+    ".obj, .ply, .stl, .off, .gltf, .glb (each optionally followed by .gz)";
 
 /// Decompressed gzip data may be at most this many times the compressed size (plus
 /// 64 KiB, so tiny files are never refused).
@@ -108,11 +114,22 @@ pub enum Format {
     Stl,
     /// Object File Format (text; `OFF`, `COFF`, `NOFF`, `STOFF`... headers).
     Off,
+    /// glTF 2.0 JSON; buffers in `data:` URIs or in files beside it (see [`gltf`]).
+    Gltf,
+    /// glTF 2.0 binary container (GLB).
+    Glb,
 }
 
 impl Format {
     /// All formats, in the order of [`SUPPORTED_EXTENSIONS`].
-    pub const ALL: [Format; 4] = [Format::Obj, Format::Ply, Format::Stl, Format::Off];
+    pub const ALL: [Format; 6] = [
+        Format::Obj,
+        Format::Ply,
+        Format::Stl,
+        Format::Off,
+        Format::Gltf,
+        Format::Glb,
+    ];
 
     /// The usual extension, lower case, without the dot.
     pub fn extension(self) -> &'static str {
@@ -121,6 +138,8 @@ impl Format {
             Format::Ply => "ply",
             Format::Stl => "stl",
             Format::Off => "off",
+            Format::Gltf => "gltf",
+            Format::Glb => "glb",
         }
     }
 
@@ -131,6 +150,8 @@ impl Format {
             Format::Ply => "a PLY",
             Format::Stl => "an STL",
             Format::Off => "an OFF",
+            Format::Gltf => "a glTF",
+            Format::Glb => "a binary glTF",
         }
     }
 
@@ -208,8 +229,14 @@ pub struct ReadNotes {
     /// that are not kept as channels (a lone member of a colour, normal or texture
     /// coordinate set such as `red` without `green`, a name another channel has, those
     /// past the channel limit). Scalar vertex properties are otherwise kept as
-    /// channels ([`crate::attributes`]). Default 0.
+    /// channels ([`crate::attributes`]). glTF vertex attributes that are not read
+    /// (`TANGENT`, `JOINTS_n`, `WEIGHTS_n`, matrix-typed `_NAME` ones), counted once per
+    /// primitive and node, are counted here too. Default 0.
     pub skipped_properties: usize,
+    /// glTF mesh primitives not read: points and lines (`POINTS`, `LINES`,
+    /// `LINE_LOOP`, `LINE_STRIP`) and primitives without positions, counted once per
+    /// node that places them. Default 0.
+    pub skipped_primitives: usize,
     /// Text lines holding bytes that are not UTF-8 (in names and comments; Latin-1
     /// material names are common), read as bytes. Default 0.
     pub non_utf8_lines: usize,
@@ -252,14 +279,27 @@ pub(crate) fn strip_bom(bytes: &[u8]) -> (&[u8], bool) {
 /// assert_eq!(err.to_string(), "line 4: unexpected end of file after 2 of 3 vertices");
 /// ```
 pub fn read_bytes(bytes: &[u8], format: Format) -> Result<LoadedMesh, ReadError> {
-    if is_gzip(bytes) {
-        let data = gunzip(bytes)?;
-        return read_plain(&data, format);
-    }
-    read_plain(bytes, format)
+    read_with(bytes, format, None)
 }
 
-fn read_plain(bytes: &[u8], format: Format) -> Result<LoadedMesh, ReadError> {
+/// [`read_bytes`], with a way to open the external buffer files of glTF.
+fn read_with(
+    bytes: &[u8],
+    format: Format,
+    external: Option<gltf::External<'_>>,
+) -> Result<LoadedMesh, ReadError> {
+    if is_gzip(bytes) {
+        let data = gunzip(bytes)?;
+        return read_plain(&data, format, external);
+    }
+    read_plain(bytes, format, external)
+}
+
+fn read_plain(
+    bytes: &[u8],
+    format: Format,
+    external: Option<gltf::External<'_>>,
+) -> Result<LoadedMesh, ReadError> {
     if bytes.is_empty() {
         return Err(ReadError::new(ReadErrorKind::Empty, None));
     }
@@ -278,6 +318,7 @@ fn read_plain(bytes: &[u8], format: Format) -> Result<LoadedMesh, ReadError> {
         Format::Ply => ply::read(text, &mut notes)?,
         Format::Stl => stl::read(text, &mut notes)?,
         Format::Off => off::read(text, &mut notes)?,
+        Format::Gltf | Format::Glb => gltf::read(text, format, external, &mut notes)?,
     };
     let loaded = LoadedMesh { mesh, notes };
     // The parsers report most problems with a place; this is the safety net that makes
@@ -325,7 +366,8 @@ fn gunzip(bytes: &[u8]) -> Result<Vec<u8>, ReadError> {
 }
 
 /// Reads a mesh file; the format comes from the name ([`Format::from_path`]),
-/// gzip is detected by content. Errors name the file.
+/// gzip is detected by content. Errors name the file. A `.gltf` file's external
+/// buffers are read from paths relative to its directory.
 ///
 /// ```
 /// # fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -352,7 +394,28 @@ pub fn read_path(path: &Path) -> Result<LoadedMesh, IoError> {
         action: "read",
         source,
     })?;
-    read_bytes(&bytes, format).map_err(read_err)
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let open = |uri: &str, len: usize| read_buffer_file(&dir.join(uri), uri, len);
+    read_with(&bytes, format, Some(&open)).map_err(read_err)
+}
+
+/// The first `len` bytes of a glTF buffer file (`uri` as the glTF names it); fewer
+/// when the file is shorter, which the caller reports. Reading stops at `len`, so a
+/// large file is not read whole.
+fn read_buffer_file(path: &Path, uri: &str, len: usize) -> Result<Vec<u8>, ReadError> {
+    let fail = |e: std::io::Error| {
+        ReadError::new(
+            ReadErrorKind::BufferFile {
+                uri: uri.to_string(),
+                detail: e.to_string(),
+            },
+            None,
+        )
+    };
+    let file = std::fs::File::open(path).map_err(fail)?;
+    let mut data = Vec::new();
+    file.take(len as u64).read_to_end(&mut data).map_err(fail)?;
+    Ok(data)
 }
 
 /// Something a mesh carries that a format cannot hold, and why: what a writer leaves
@@ -416,6 +479,10 @@ pub fn unwritable(attributes: &crate::attributes::Attributes, format: Format) ->
                 off::Slot::Vertex | off::Slot::Face => None,
             })
             .collect(),
+        Format::Gltf | Format::Glb => gltf::semantics(channels)
+            .into_iter()
+            .map(Result::err)
+            .collect(),
     };
     let mut out: Vec<Unwritable> = channels
         .iter()
@@ -441,6 +508,10 @@ pub fn unwritable(attributes: &crate::attributes::Attributes, format: Format) ->
             Format::Stl => Some("STL holds positions only"),
             Format::Ply => Some("PLY has no materials, groups or material libraries"),
             Format::Off => Some("OFF has no materials, groups or material libraries"),
+            // Materials and groups become glTF materials and meshes.
+            Format::Gltf | Format::Glb => {
+                Some("glTF has no material libraries").filter(|_| what == "material libraries")
+            }
         };
         if let Some(reason) = reason.filter(|_| present) {
             out.push(Unwritable {
@@ -462,8 +533,8 @@ pub fn write_to<W: Write>(out: W, mesh: &IndexedMesh, format: Format) -> std::io
 }
 
 /// [`write_to`] with `comments` in the file's header (one line each; a line break in
-/// one becomes a space): PLY `comment` lines, OBJ and OFF `#` lines. STL has no place
-/// for them, and they are left out.
+/// one becomes a space): PLY `comment` lines, OBJ and OFF `#` lines. STL and glTF get
+/// none (STL has no place for them; glTF's would be JSON `extras`, not written yet).
 pub fn write_commented<W: Write>(
     out: W,
     mesh: &IndexedMesh,
@@ -496,6 +567,7 @@ pub fn write_commented<W: Write>(
         Format::Ply => ply::write(&mut out, mesh, comments)?,
         Format::Stl => stl::write(&mut out, mesh)?,
         Format::Off => off::write(&mut out, mesh, comments)?,
+        Format::Gltf | Format::Glb => gltf::write(&mut out, mesh, format)?,
     }
     out.flush()
 }

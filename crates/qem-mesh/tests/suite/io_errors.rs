@@ -292,7 +292,7 @@ fn unknown_extension_lists_supported_ones() {
     let e = read_path(Path::new("/nonexistent/bunny.js")).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "/nonexistent/bunny.js: unsupported file extension \".js\"; supported: .obj, .ply, .stl, .off (each optionally followed by .gz)"
+        "/nonexistent/bunny.js: unsupported file extension \".js\"; supported: .obj, .ply, .stl, .off, .gltf, .glb (each optionally followed by .gz)"
     );
     assert_eq!(
         Format::from_path(Path::new("a.OBJ.GZ")).unwrap(),
@@ -377,6 +377,15 @@ fn round_trips_every_format_plain_and_gzipped() {
                         assert_eq!(back.positions[3 * t + k], want);
                     }
                 }
+            } else if matches!(f, Format::Gltf | Format::Glb) {
+                // float32 positions, the vertex order kept.
+                assert_eq!(back.triangles, m.triangles, "{f:?}");
+                let want: Vec<_> = m
+                    .positions
+                    .iter()
+                    .map(|p| p.map(|c| f64::from(c as f32)))
+                    .collect();
+                assert_eq!(back.positions, want, "{f:?}");
             } else {
                 assert_eq!(back, m, "{f:?}");
             }
