@@ -11,6 +11,10 @@
 //! exception: [`QemError`] (a `ValueError`) for what qem refuses, carrying its message,
 //! `TypeError` for arguments of the wrong kind.
 //!
+//! Attributes (texture coordinates, normals, colours, generic channels, materials) come
+//! and go as dicts of per-vertex arrays; the `attributes` module turns them into qem's
+//! per-corner channels and back, splitting the output at its seams.
+//!
 //! The pure-Python part of the package (`python/qem/__init__.py`) re-exports these
 //! functions and adds the trimesh helper; `python/qem/__init__.pyi` has the types.
 
@@ -20,7 +24,7 @@ use numpy::{Element, PyArray2, PyUntypedArray};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyBool, PyDict, PyList, PyString};
+use pyo3::types::{PyBool, PyDict, PyList, PyString, PyTuple};
 use qem_mesh::clean::CleanOptions;
 use qem_mesh::measure::{MeasureOptions, Measurement};
 use qem_mesh::simplify::{
@@ -30,6 +34,8 @@ use qem_mesh::simplify::{
 use qem_mesh::IndexedMesh;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
+
+mod attributes;
 
 create_exception!(
     qem,
@@ -222,27 +228,41 @@ fn read_faces(
     }
 }
 
-/// A mesh argument: a `(vertices, faces)` pair, or any object with `vertices` and
-/// `faces` attributes (a `trimesh.Trimesh`, for one).
-fn read_mesh(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<IndexedMesh> {
-    let (vertices, faces) = if obj.hasattr("vertices")? && obj.hasattr("faces")? {
-        (obj.getattr("vertices")?, obj.getattr("faces")?)
+/// A mesh argument: a `(vertices, faces)` pair, a `(vertices, faces, attributes)`
+/// triple (as `load(path, attributes=True)` returns), or any object with `vertices`
+/// and `faces` attributes (a `trimesh.Trimesh`, for one). The attributes are read
+/// only `with_attributes` (by `save`; `measure` compares surfaces and leaves them).
+fn read_mesh(obj: &Bound<'_, PyAny>, name: &str, with_attributes: bool) -> PyResult<IndexedMesh> {
+    let (vertices, faces, attributes) = if obj.hasattr("vertices")? && obj.hasattr("faces")? {
+        (obj.getattr("vertices")?, obj.getattr("faces")?, None)
+    } else if let Ok((v, f, a)) =
+        obj.extract::<(Bound<'_, PyAny>, Bound<'_, PyAny>, Bound<'_, PyAny>)>()
+    {
+        (v, f, Some(a))
     } else {
-        let pair: (Bound<'_, PyAny>, Bound<'_, PyAny>) = obj.extract().map_err(|_| {
+        let (v, f): (Bound<'_, PyAny>, Bound<'_, PyAny>) = obj.extract().map_err(|_| {
             PyTypeError::new_err(format!(
-                "{name} must be a (vertices, faces) pair or have .vertices and .faces, \
-                 not {}",
+                "{name} must be a (vertices, faces) pair, a (vertices, faces, attributes) \
+                 triple, or have .vertices and .faces, not {}",
                 obj.get_type()
                     .name()
                     .map(|n| n.to_string())
                     .unwrap_or_default()
             ))
         })?;
-        pair
+        (v, f, None)
     };
     let (positions, _) = read_vertices(&vertices, &format!("{name} vertices"))?;
     let (triangles, _) = read_faces(&faces, positions.len(), &format!("{name} faces"))?;
-    Ok(IndexedMesh::new(positions, triangles))
+    let mut attrs = None;
+    if let Some(a) = attributes.filter(|a| with_attributes && !a.is_none()) {
+        attrs = Some(attributes::read_attributes(&a, positions.len(), &triangles)?.for_save()?);
+    }
+    let mesh = IndexedMesh::new(positions, triangles);
+    Ok(match attrs {
+        Some(a) => mesh.with_attributes(a),
+        None => mesh,
+    })
 }
 
 // --------------------------------------------------------------------------- arrays out
@@ -363,6 +383,7 @@ const OPTION_NAMES: &[&str] = &[
     "order",
     "strict",
     "method",
+    "attribute_weights",
 ];
 
 /// The keys of the `clean` option, the fields of [`CleanOptions`].
@@ -538,6 +559,10 @@ fn simplify_options(options: Option<&Bound<'_, PyDict>>) -> PyResult<SimplifyOpt
             }),
             "locked_vertices" => o.with_locked_vertices(locked_vertices(v)?),
             "clean" => o.with_clean(clean_options(v)?),
+            "attribute_weights" => {
+                let preset = o.attribute_weights;
+                o.with_attribute_weights(attributes::attribute_weights(v, preset)?)
+            }
             "order" => o.with_order(match choice("order", v, &["greedy", "passes"])? {
                 "greedy" => ContractionOrder::Greedy,
                 _ => ContractionOrder::Passes,
@@ -545,7 +570,7 @@ fn simplify_options(options: Option<&Bound<'_, PyDict>>) -> PyResult<SimplifyOpt
             _ => {
                 return Err(PyTypeError::new_err(format!(
                     "simplify() got an unexpected keyword argument '{key}'; the options are \
-                     progress, {}",
+                     progress, attributes, {}",
                     OPTION_NAMES.join(", ")
                 )))
             }
@@ -653,6 +678,13 @@ fn options_dict<'py>(py: Python<'py>, o: &SimplifyOptions) -> PyResult<Bound<'py
             Method::Contraction => "contraction",
             Method::Clustering => "clustering",
         },
+    )?;
+    // Not an option of the library but a keyword argument of simplify(), listed so the
+    // dict names every keyword argument: None, the 3-tuple, as without it.
+    d.set_item("attributes", py.None())?;
+    d.set_item(
+        "attribute_weights",
+        attributes::weights_dict(py, &o.attribute_weights)?,
     )?;
     Ok(d)
 }
@@ -798,13 +830,21 @@ impl Observer for PyObserver {
 /// as a dict (the keys of `qem simplify --report`: triangles_out, max_error as a
 /// fraction of the bounding-box diagonal, stop_reason, rejected, timings_ms, ...).
 ///
+/// attributes: a dict of per-vertex arrays, "uv" (n, 2), "normal" (n, 3), "colour" or
+/// "color" (n, 3 or 4, floats 0 to 1), any other key a generic channel ((n,) or (n, k),
+/// k ≤ 4), float32 or float64; "material": one integer label per face. With it the
+/// result is (vertices, faces, attributes, report): the attributes carried through the
+/// simplification (seams kept), as a dict with the same keys, dtypes and shapes, and
+/// the output split at its seams, so a vertex on a seam comes out once per side (the
+/// returned vertex count can exceed report["vertices_out"], which counts it once).
+///
 /// Options (keyword only; each left out has the library's default, see
 /// qem.default_options()): ratio or triangles (the target; default ratio=0.5), fast
 /// (start from SimplifyOptions::FAST), max_error, absolute, pair_threshold,
 /// max_virtual_pairs_per_vertex, virtual_pairs, placement, weighting, quadrics,
 /// boundary, max_normal_angle, min_triangle_quality, orientation_check,
-/// preserve_topology, locked_vertices, clean, order, strict, method. The
-/// stub file (qem/__init__.pyi) documents each.
+/// preserve_topology, locked_vertices, clean, order, strict, method,
+/// attribute_weights. The stub file (qem/__init__.pyi) documents each.
 ///
 /// progress: called as progress(fraction) every few thousand contractions, fraction in
 /// [0, 1]; returning False cancels the run (the partial, valid result is returned with
@@ -813,23 +853,37 @@ impl Observer for PyObserver {
 /// The GIL is released during the work. Raises QemError (a ValueError) with qem's
 /// message when the input or the options are refused.
 #[pyfunction]
-#[pyo3(signature = (vertices, faces, *, progress=None, **options))]
+#[pyo3(signature = (vertices, faces, *, progress=None, attributes=None, **options))]
 fn simplify<'py>(
     py: Python<'py>,
     vertices: &Bound<'py, PyAny>,
     faces: &Bound<'py, PyAny>,
     progress: Option<Py<PyAny>>,
+    attributes: Option<&Bound<'py, PyAny>>,
     options: Option<&Bound<'py, PyDict>>,
-) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyDict>)> {
+) -> PyResult<Bound<'py, PyTuple>> {
     let options = simplify_options(options)?;
     let (positions, float_kind) = read_vertices(vertices, "vertices")?;
     let (triangles, index_kind) = read_faces(faces, positions.len(), "faces")?;
+    let attributes = attributes
+        .filter(|a| !a.is_none())
+        .map(|a| attributes::read_attributes(a, positions.len(), &triangles))
+        .transpose()?;
     if let Some(callback) = &progress {
         if !callback.bind(py).is_callable() {
             return Err(PyTypeError::new_err("progress must be callable"));
         }
     }
-    let mesh = IndexedMesh::new(positions, triangles);
+    if options.method == Method::Clustering && attributes.as_ref().is_some_and(|a| !a.is_empty()) {
+        return Err(qem_error(
+            "method='clustering' keeps positions only and cannot carry attributes: \
+             use method='contraction', or leave attributes out",
+        ));
+    }
+    let mut mesh = IndexedMesh::new(positions, triangles);
+    if let Some(a) = &attributes {
+        mesh = mesh.with_attributes(a.for_simplify());
+    }
     let mut observer = PyObserver {
         callback: progress,
         cancelled: false,
@@ -846,9 +900,20 @@ fn simplify<'py>(
     }
     let out = result.map_err(|e| qem_error(e.to_string()))?;
     let report = report_dict(py, &out.report, elapsed)?;
-    let vertices = vertices_out(py, out.mesh.positions, float_kind)?;
-    let faces = faces_out(py, out.mesh.triangles, index_kind)?;
-    Ok((vertices, faces, report))
+    let Some(attributes) = attributes else {
+        let vertices = vertices_out(py, out.mesh.positions, float_kind)?;
+        let faces = faces_out(py, out.mesh.triangles, index_kind)?;
+        return PyTuple::new(py, [vertices, faces, report.into_any()]);
+    };
+    let split = py.detach(|| qem_mesh::attributes::split_at_seams(&out.mesh));
+    drop(out);
+    let attributes = attributes.output(py, &split)?;
+    let vertices = vertices_out(py, split.positions, float_kind)?;
+    let faces = faces_out(py, split.triangles, index_kind)?;
+    PyTuple::new(
+        py,
+        [vertices, faces, attributes.into_any(), report.into_any()],
+    )
 }
 
 /// The options simplify() uses when none is given (or, with fast=True, its fast=True
@@ -900,8 +965,8 @@ fn measure<'py>(
         max_samples: max_samples.or(defaults.max_samples),
         seed: seed.unwrap_or(defaults.seed),
     };
-    let a = read_mesh(a, "a")?;
-    let b = read_mesh(b, "b")?;
+    let a = read_mesh(a, "a", false)?;
+    let b = read_mesh(b, "b", false)?;
     let m = py
         .detach(|| qem_mesh::measure::measure(&a, &b, &options))
         .map_err(|e| qem_error(e.to_string()))?;
@@ -910,28 +975,70 @@ fn measure<'py>(
 
 /// Reads a mesh file: .obj .ply .stl .off, each optionally gzipped (.gz). Returns
 /// (vertices, faces): a float64 (n, 3) array and a uint32 (m, 3) array, polygons split
-/// into triangles (texture coordinates and normals are not returned yet). Raises
-/// QemError naming the file and the place (line, byte, vertex or face) when the file
-/// cannot be read or is malformed.
+/// into triangles. With attributes=True returns (vertices, faces, attributes): the
+/// mesh split at its seams so that every channel is per vertex (a vertex with two
+/// texture coordinates comes out twice), attributes a dict of float32 (n, k) arrays
+/// under the channels' names ("uv", "normal", "colour", a PLY property's name) and,
+/// when the file has materials, "material" (int32 per face, -1 for none) and
+/// "material_names". Raises QemError naming the file and the place (line, byte,
+/// vertex or face) when the file cannot be read or is malformed.
 #[pyfunction]
-fn load(py: Python<'_>, path: PathBuf) -> PyResult<(Bound<'_, PyAny>, Bound<'_, PyAny>)> {
+#[pyo3(signature = (path, *, attributes=false))]
+fn load(py: Python<'_>, path: PathBuf, attributes: bool) -> PyResult<Bound<'_, PyTuple>> {
     let loaded = py
         .detach(|| qem_mesh::io::read_path(&path))
         .map_err(|e| qem_error(e.to_string()))?;
     let mesh = loaded.mesh;
-    Ok((
-        owned_array(py, mesh.positions)?,
-        owned_array(py, mesh.triangles)?,
-    ))
+    if !attributes {
+        return PyTuple::new(
+            py,
+            [
+                owned_array(py, mesh.positions)?,
+                owned_array(py, mesh.triangles)?,
+            ],
+        );
+    }
+    let split = py.detach(|| qem_mesh::attributes::split_at_seams(&mesh));
+    drop(mesh);
+    let dict = attributes::loaded_dict(py, &split)?;
+    PyTuple::new(
+        py,
+        [
+            owned_array(py, split.positions)?,
+            owned_array(py, split.triangles)?,
+            dict.into_any(),
+        ],
+    )
 }
 
 /// Writes a mesh, in the format the name gives (.obj .ply .stl .off, gzipped when it
-/// ends in .gz); mesh is a (vertices, faces) pair or has .vertices and .faces. The file
-/// is written atomically: on any error it keeps its old content (or does not appear).
-/// PLY is written binary little-endian with double coordinates, STL binary.
+/// ends in .gz); mesh is a (vertices, faces) pair, a (vertices, faces, attributes)
+/// triple (the dict simplify() takes, or load(path, attributes=True) gives), or has
+/// .vertices and .faces. The file is written atomically: on any error it keeps its old
+/// content (or does not appear). PLY is written binary little-endian with double
+/// coordinates, STL binary. An attribute the format cannot hold (colours in OBJ,
+/// anything in STL) is left out with a UserWarning saying which and why.
 #[pyfunction]
 fn save(py: Python<'_>, path: PathBuf, mesh: &Bound<'_, PyAny>) -> PyResult<()> {
-    let mesh = read_mesh(mesh, "mesh")?;
+    let mesh = read_mesh(mesh, "mesh", true)?;
+    if let Ok(format) = qem_mesh::io::Format::from_path(&path) {
+        let left: Vec<String> = qem_mesh::io::unwritable(&mesh.attributes, format)
+            .into_iter()
+            .map(|u| format!("{} ({})", u.what, u.reason))
+            .collect();
+        if !left.is_empty() {
+            let message = format!(
+                "qem.save: left out of {}: {}",
+                path.display(),
+                left.join(", ")
+            );
+            // A message with a NUL (from a path) is not worth failing the write for.
+            if let Ok(message) = std::ffi::CString::new(message) {
+                let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
+                PyErr::warn(py, &category, &message, 1)?;
+            }
+        }
+    }
     py.detach(|| qem_mesh::io::write_path(&path, &mesh))
         .map_err(|e| qem_error(e.to_string()))
 }

@@ -23,8 +23,47 @@ Vertices = npt.NDArray[Union[np.float32, np.float64]]
 """An (n, 3) float32 or float64 array of positions (nested lists are converted)."""
 Faces = npt.NDArray[Union[np.int32, np.int64, np.uint32, np.uint64]]
 """An (m, 3) array of vertex indices, each in [0, n) (nested lists are converted)."""
-Mesh = Union[Tuple[Any, Any], Any]
-"""A (vertices, faces) pair, or any object with .vertices and .faces (trimesh.Trimesh)."""
+Mesh = Union[Tuple[Any, Any], Tuple[Any, Any, "Attributes"], Any]
+"""A (vertices, faces) pair, a (vertices, faces, attributes) triple, or any object with
+.vertices and .faces (trimesh.Trimesh)."""
+
+Attributes = dict[str, Any]
+"""Per-vertex attributes, as :func:`simplify` takes and returns them and
+``load(path, attributes=True)`` returns them: a dict of NumPy arrays (float32 or
+float64; nested lists are converted), one row per vertex.
+
+- ``"uv"``: (n, 2) texture coordinates.
+- ``"normal"``: (n, 3) normals (the simplified ones are unit length).
+- ``"colour"`` or ``"color"`` (one of them): (n, 3) or (n, 4) RGB(A) floats in [0, 1]
+  (divide 8-bit colours by 255).
+- any other key: a generic channel of that name, (n,) or (n, k) with k from 1 to 4.
+- ``"material"``: a per-face integer array (m,) (int32, int64, uint32 or uint64) of
+  labels; faces with different labels are never merged across their border, and each
+  output face has its input face's label.
+- ``"material_names"``: a list of str, ``load`` gives it with ``"material"`` (label i is
+  the material named ``material_names[i]``, -1 none) and ``save`` writes the names
+  (OBJ ``usemtl``); :func:`simplify` returns it as it is.
+
+Per vertex means each triangle corner takes its vertex's value. A seam (a UV island's
+border, a hard normal edge) is two vertices at one position with different values:
+qem welds them into one vertex with a value per side, keeps the seam through the
+simplification, and splits the output there again.
+"""
+
+class AttributeWeights(TypedDict, total=False):
+    """How much each kind of channel weighs against positions (each key optional; the
+    others keep their defaults): an attribute difference of 1 costs as much as a
+    distance of ``weight`` in the mesh scaled so its bounding box spans about 2. 0 leaves
+    a kind out of the cost (its values still follow the vertices)."""
+
+    uv: float
+    """Texture coordinates. Default: 0.3."""
+    normal: float
+    """Normals. Default: 0.15."""
+    colour: float
+    """Colours (``color`` is accepted too). Default: 1.0."""
+    generic: float
+    """Every generic channel. Default: 1.0."""
 
 class CleanOptions(TypedDict, total=False):
     """The cleaning passes run before simplification (each key optional)."""
@@ -109,6 +148,7 @@ def simplify(
     faces: Faces | Sequence[Sequence[int]],
     *,
     progress: Callable[[float], object] | None = None,
+    attributes: Attributes | None = None,
     fast: bool = False,
     ratio: float | None = None,
     triangles: int | None = None,
@@ -130,16 +170,29 @@ def simplify(
     order: Literal["greedy", "passes"] = "greedy",
     strict: bool = False,
     method: Literal["contraction", "clustering"] = "contraction",
-) -> Tuple[Vertices, Faces, Report]:
+    attribute_weights: AttributeWeights | None = {"uv": 0.3, "normal": 0.15, "colour": 1.0, "generic": 1.0},
+) -> Union[Tuple[Vertices, Faces, Report], Tuple[Vertices, Faces, Attributes, Report]]:
     """Simplifies a triangle mesh by Garland-Heckbert pair contraction.
 
     Returns ``(vertices, faces, report)``: new arrays with the input's dtypes and the
-    report. Any triangle input is accepted (non-manifold, open, unwelded, several
+    report; with ``attributes``, ``(vertices, faces, attributes, report)``. Any triangle input is accepted (non-manifold, open, unwelded, several
     parts, degenerate or duplicate faces); the output is always valid (indices in
     range, no repeated vertex in a face, no zero-area face, finite coordinates, never
     more triangles than the input), and the same input and options give the same
     output bit for bit. Reaching the target is not guaranteed: ``stop_reason`` says
     why a run stopped short. The GIL is released during the work.
+
+    - ``attributes``: per-vertex texture coordinates, normals, colours, generic
+      channels and per-face material labels (:data:`Attributes`), checked (a QemError
+      naming the key and the shape it expects) and simplified with the mesh: seams and
+      material borders are kept (a seam vertex only moves along its seam), the values
+      at a moved vertex come from attribute quadrics, normals come out unit length and
+      colours in [0, 1]. The result is then the 4-tuple, its attributes a dict with the
+      same keys, dtypes and shapes, one row per output vertex; the output is split at
+      its seams, so a vertex on a seam is returned once per side and ``len(vertices)``
+      can exceed ``report["vertices_out"]`` (which counts it once). ``None`` (the
+      default) returns the 3-tuple exactly as without it. Not with
+      ``method="clustering"``, which keeps positions only (QemError).
 
     Options (the defaults shown are those with ``fast=False``):
 
@@ -194,6 +247,9 @@ def simplify(
       --cluster``: many times faster, near the count on any input, no topology kept;
       only the target applies, and ``preserve_topology``, ``locked_vertices``,
       ``boundary="locked"`` and ``max_error`` are refused with QemError).
+    - ``attribute_weights``: how much each kind of attribute weighs against positions
+      (:class:`AttributeWeights`; kinds left out keep their defaults, an unknown key is
+      a QemError); no effect without ``attributes``.
 
     Raises QemError (a ValueError) when the input or the options are refused, with
     qem's message; TypeError for an argument of the wrong kind or an unknown option.
@@ -203,16 +259,26 @@ def simplify_trimesh(
     mesh: Any,
     *,
     progress: Callable[[float], object] | None = None,
+    keep_attributes: bool = True,
     **options: Any,
 ) -> Tuple[Any, Report]:
     """Simplifies a ``trimesh.Trimesh`` with :func:`simplify`'s options; returns
     ``(new_trimesh, report)``. The new mesh is built with ``process=False``. Needs
-    trimesh, imported only when called."""
+    trimesh, imported only when called.
+
+    With ``keep_attributes`` (the default) the texture coordinates (``visual.uv`` of a
+    ``TextureVisuals``, whose material is kept), vertex colours and vertex normals (only
+    when the mesh already has them: read from its file or computed before the call) are
+    simplified along and set on the new mesh, which is then split at its seams (it can
+    have more vertices than ``report["vertices_out"]``). A mesh without any of them
+    gives what :func:`simplify` gives."""
 
 def default_options(fast: bool = False) -> dict[str, Any]:
     """The options :func:`simplify` uses when none is given (with ``fast=True``: its
     ``fast=True`` preset) as a dict of its keyword arguments; passing it back as
-    ``**options`` changes nothing. Read from the library, so always current."""
+    ``**options`` changes nothing. Read from the library, so always current. It lists
+    ``attributes`` too, as None (no attributes, the 3-tuple), and ``attribute_weights``
+    with every kind's weight."""
 
 def measure(
     a: Mesh,
@@ -230,13 +296,33 @@ def measure(
     same figures to the bit whatever the number of cores. The GIL is released during
     the work. Raises QemError when a mesh is invalid or a's extent is zero."""
 
-def load(path: str | os.PathLike[str]) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32]]:
+def load(
+    path: str | os.PathLike[str], *, attributes: bool = False
+) -> Union[
+    Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32]],
+    Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32], Attributes],
+]:
     """Reads an .obj .ply .stl or .off file (optionally .gz): ``(vertices, faces)`` as
     float64 (n, 3) and uint32 (m, 3) arrays, polygons split into triangles. Raises
-    QemError naming the file and the place when it cannot be read or is malformed."""
+    QemError naming the file and the place when it cannot be read or is malformed.
+
+    With ``attributes=True``: ``(vertices, faces, attributes)``, the file's texture
+    coordinates, normals, colours and other channels per vertex (:data:`Attributes`,
+    float32 (n, k) arrays under the channels' names: ``"uv"``, ``"normal"``,
+    ``"colour"``, a PLY property's name) and its materials (``"material"``, int32 per
+    face, -1 for none, with ``"material_names"``). The mesh is split at its seams for
+    this: a vertex with a different texture coordinate (or normal) in different faces
+    comes out once per value, so ``vertices`` can be longer than without attributes.
+    OBJ groups and material libraries are not returned."""
 
 def save(path: str | os.PathLike[str], mesh: Mesh) -> None:
     """Writes a mesh in the format its name gives (.obj .ply .stl .off, gzipped with
-    .gz), atomically: on any error the file keeps its old content. Raises QemError."""
+    .gz), atomically: on any error the file keeps its old content. Raises QemError.
+
+    ``mesh`` may be a ``(vertices, faces, attributes)`` triple: the channels are written
+    where the format holds them (OBJ ``vt``/``vn``, PLY vertex properties, OFF colours)
+    and the materials as OBJ ``usemtl`` (named by ``"material_names"`` when given, else
+    by their labels); what the format cannot hold is left out with a ``UserWarning``
+    naming it. A trimesh's visuals are not written (only its vertices and faces)."""
 
 __all__: list[str]
