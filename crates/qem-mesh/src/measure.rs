@@ -173,21 +173,7 @@ pub fn measure(
     if !(options.samples_per_face.is_finite() && options.samples_per_face >= 0.0) {
         return Err(MeasureError::BadSamplesPerFace(options.samples_per_face));
     }
-    a.validate().map_err(|error| MeasureError::Invalid {
-        mesh: Which::A,
-        error,
-    })?;
-    b.validate().map_err(|error| MeasureError::Invalid {
-        mesh: Which::B,
-        error,
-    })?;
-    let diagonal = match a.bounding_box() {
-        Some((lo, hi)) => length(sub(hi, lo)),
-        None => 0.0,
-    };
-    if diagonal.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-        return Err(MeasureError::ZeroDiagonal);
-    }
+    let diagonal = validated_diagonal(a, b)?;
     let (index_a, index_b) = rayon::join(|| TriangleBvh::new(a), || TriangleBvh::new(b));
     // Different streams for the two directions, so the two sample sets are independent
     // even when the meshes are identical.
@@ -207,21 +193,8 @@ pub fn measure(
     })
 }
 
-/// The distance from each vertex of `b` to the surface of `a`, as a fraction of `a`'s
-/// bounding-box diagonal (a vertex no triangle of `b` uses gets 0): what a heat map of
-/// `b` shows. Fails as [`measure`] does.
-///
-/// ```
-/// use qem_mesh::IndexedMesh;
-/// use qem_mesh::measure::vertex_distances;
-/// let square = |z: f64| IndexedMesh::new(
-///     vec![[0.0, 0.0, z], [1.0, 0.0, z], [1.0, 1.0, z], [0.0, 1.0, z]],
-///     vec![[0, 1, 2], [0, 2, 3]],
-/// );
-/// let d = vertex_distances(&square(0.0), &square(0.5)).unwrap();
-/// assert!(d.iter().all(|&x| (x - 0.5 / 2f64.sqrt()).abs() < 1e-12));
-/// ```
-pub fn vertex_distances(a: &IndexedMesh, b: &IndexedMesh) -> Result<Vec<f64>, MeasureError> {
+/// Checks both meshes and returns `a`'s bounding-box diagonal, refused when it is 0.
+fn validated_diagonal(a: &IndexedMesh, b: &IndexedMesh) -> Result<f64, MeasureError> {
     a.validate().map_err(|error| MeasureError::Invalid {
         mesh: Which::A,
         error,
@@ -237,6 +210,25 @@ pub fn vertex_distances(a: &IndexedMesh, b: &IndexedMesh) -> Result<Vec<f64>, Me
     if diagonal.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
         return Err(MeasureError::ZeroDiagonal);
     }
+    Ok(diagonal)
+}
+
+/// The distance from each vertex of `b` to the surface of `a`, as a fraction of `a`'s
+/// bounding-box diagonal (a vertex no triangle of `b` uses gets 0): what a heat map of
+/// `b` shows. Fails as [`measure`] does.
+///
+/// ```
+/// use qem_mesh::IndexedMesh;
+/// use qem_mesh::measure::vertex_distances;
+/// let square = |z: f64| IndexedMesh::new(
+///     vec![[0.0, 0.0, z], [1.0, 0.0, z], [1.0, 1.0, z], [0.0, 1.0, z]],
+///     vec![[0, 1, 2], [0, 2, 3]],
+/// );
+/// let d = vertex_distances(&square(0.0), &square(0.5)).unwrap();
+/// assert!(d.iter().all(|&x| (x - 0.5 / 2f64.sqrt()).abs() < 1e-12));
+/// ```
+pub fn vertex_distances(a: &IndexedMesh, b: &IndexedMesh) -> Result<Vec<f64>, MeasureError> {
+    let diagonal = validated_diagonal(a, b)?;
     let mut used = vec![false; b.positions.len()];
     for t in &b.triangles {
         for &i in t {

@@ -10,29 +10,11 @@
 use std::path::Path;
 
 use qem_mesh::attributes::{Channel, ChannelKind, FaceLabels};
-use qem_mesh::io::{read_bytes, read_path, unwritable, write_path, write_to, Format, LoadedMesh};
+use qem_mesh::io::{read_bytes, read_path, unwritable, write_path, Format};
 use qem_mesh::IndexedMesh;
 use serde_json::{json, Value};
 
-fn load(bytes: &[u8], format: Format) -> LoadedMesh {
-    read_bytes(bytes, format).unwrap_or_else(|e| panic!("{format:?} refused: {e}"))
-}
-
-fn encode(mesh: &IndexedMesh, format: Format) -> Vec<u8> {
-    let mut out = Vec::new();
-    write_to(&mut out, mesh, format).unwrap();
-    out
-}
-
-fn err(bytes: &[u8], format: Format) -> String {
-    match read_bytes(bytes, format) {
-        Ok(m) => panic!(
-            "expected an error, loaded {} triangles",
-            m.mesh.triangle_count()
-        ),
-        Err(e) => e.to_string(),
-    }
-}
+use crate::attributes_common::{encode, err, load};
 
 /// A GLB file from a JSON document and a BIN chunk.
 fn glb(doc: &Value, bin: &[u8]) -> Vec<u8> {

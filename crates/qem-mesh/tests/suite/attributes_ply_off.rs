@@ -9,7 +9,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use qem_mesh::attributes::{Channel, ChannelKind};
-use qem_mesh::io::{read_bytes, read_path, unwritable, write_to, Format, LoadedMesh};
+use qem_mesh::io::{read_path, unwritable, Format};
 use qem_mesh::IndexedMesh;
 
 /// Each corner's value in one channel (`None`: the corner has none).
@@ -41,25 +41,7 @@ fn positions_by_corner(mesh: &IndexedMesh) -> Vec<[u64; 3]> {
         .collect()
 }
 
-fn load(bytes: &[u8], format: Format) -> LoadedMesh {
-    read_bytes(bytes, format).unwrap_or_else(|e| panic!("{format:?} refused: {e}"))
-}
-
-fn encode(mesh: &IndexedMesh, format: Format) -> Vec<u8> {
-    let mut out = Vec::new();
-    write_to(&mut out, mesh, format).unwrap();
-    out
-}
-
-fn err(bytes: &[u8], format: Format) -> String {
-    match read_bytes(bytes, format) {
-        Ok(m) => panic!(
-            "expected an error, loaded {} triangles",
-            m.mesh.triangle_count()
-        ),
-        Err(e) => e.to_string(),
-    }
-}
+use crate::attributes_common::{encode, err, load};
 
 /// Writes `mesh` in `format`, reads it back, checks every corner kept its position and
 /// values, and that writing again gives the same bytes; returns what was read.

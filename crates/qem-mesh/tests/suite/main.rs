@@ -10,6 +10,8 @@ mod common;
 mod passes_common;
 
 #[cfg(feature = "io")]
+mod attributes_common;
+#[cfg(feature = "io")]
 mod attributes_gltf;
 #[cfg(feature = "io")]
 mod attributes_obj;
