@@ -116,6 +116,17 @@ impl Channel {
         self
     }
 
+    /// The same channel (kind, name, values) with other `corners`.
+    pub fn with_corners(&self, corners: Vec<[u32; 3]>) -> Channel {
+        Channel {
+            kind: self.kind,
+            name: self.name.clone(),
+            dimension: self.dimension,
+            values: self.values.clone(),
+            corners,
+        }
+    }
+
     /// How many values the channel holds.
     pub fn value_count(&self) -> usize {
         self.values.len() / self.dimension.max(1)
@@ -210,13 +221,7 @@ impl Attributes {
             channels: self
                 .channels
                 .iter()
-                .map(|c| Channel {
-                    kind: c.kind,
-                    name: c.name.clone(),
-                    dimension: c.dimension,
-                    values: c.values.clone(),
-                    corners: kept.iter().map(|&t| c.corners[t as usize]).collect(),
-                })
+                .map(|c| c.with_corners(kept.iter().map(|&t| c.corners[t as usize]).collect()))
                 .collect(),
             materials: pick(&self.materials),
             groups: pick(&self.groups),

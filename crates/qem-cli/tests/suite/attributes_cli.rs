@@ -1,7 +1,7 @@
 //! `qem simplify` keeps what the mesh carries and says so in its report.
 #![allow(clippy::unwrap_used)]
 
-use crate::common::{qem, spot, stderr};
+use crate::common::{simplify_spot as run_on_spot, spot, stderr};
 use qem_mesh::attributes::ChannelKind;
 
 /// Runs `qem simplify spot.obj -o <name> --ratio 0.1 --report` and returns the
@@ -10,16 +10,7 @@ fn simplify_spot(name: &str) -> (qem_mesh::IndexedMesh, serde_json::Value) {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join(name);
     let report = dir.path().join("report.json");
-    let o = qem(&[
-        "simplify",
-        spot().to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--ratio",
-        "0.1",
-        "--report",
-        report.to_str().unwrap(),
-    ]);
+    let o = run_on_spot(&out, "0.1", &["--report", report.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
     let json = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     (qem_mesh::io::read_path(&out).unwrap().mesh, json)
@@ -71,16 +62,7 @@ fn attribute_weights_change_the_result_and_bad_ones_are_refused() {
     let dir = tempfile::tempdir().unwrap();
     let run = |weights: &str, name: &str| {
         let out = dir.path().join(name);
-        let o = qem(&[
-            "simplify",
-            spot().to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-            "--ratio",
-            "0.1",
-            "--attribute-weights",
-            weights,
-        ]);
+        let o = run_on_spot(&out, "0.1", &["--attribute-weights", weights]);
         (o, out)
     };
     let (o, free) = run("uv=0", "free.obj");

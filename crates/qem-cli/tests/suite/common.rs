@@ -19,6 +19,14 @@ pub fn spot() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/spot.obj")
 }
 
+/// Runs `qem simplify assets/spot.obj -o out --ratio ratio` with `extra` arguments.
+pub fn simplify_spot(out: &Path, ratio: &str, extra: &[&str]) -> Output {
+    let spot = spot();
+    let mut args = vec!["simplify", s(&spot), "-o", s(out), "--ratio", ratio];
+    args.extend_from_slice(extra);
+    qem(&args)
+}
+
 /// stderr as text.
 pub fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()

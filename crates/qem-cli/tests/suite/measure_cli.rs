@@ -127,15 +127,7 @@ fn usage_errors_exit_with_2() {
 fn attribute_error_and_heat_map() {
     let dir = tempfile::tempdir().expect("tempdir");
     let simplified = dir.path().join("s.obj");
-    let o = qem(&[
-        "simplify",
-        spot().to_str().expect("UTF-8 path"),
-        "-o",
-        simplified.to_str().expect("UTF-8 path"),
-        "--ratio",
-        "0.05",
-        "--quiet",
-    ]);
+    let o = common::simplify_spot(&simplified, "0.05", &["--quiet"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let heat = dir.path().join("heat.ply");
     let json = measure_json(

@@ -214,13 +214,7 @@ impl Wedges {
             channels: attributes
                 .channels
                 .iter()
-                .map(|c| Channel {
-                    kind: c.kind,
-                    name: c.name.clone(),
-                    dimension: c.dimension,
-                    values: c.values.clone(),
-                    corners: Vec::new(),
-                })
+                .map(|c| c.with_corners(Vec::new()))
                 .collect(),
             weights: attributes
                 .channels
