@@ -457,9 +457,12 @@ pub fn unwritable(attributes: &crate::attributes::Attributes, format: Format) ->
                         ChannelKind::TexCoord | ChannelKind::Normal => {
                             Some("OBJ holds one texture coordinate and one normal per corner")
                         }
-                        ChannelKind::Color | ChannelKind::Generic => {
-                            Some("OBJ holds no colours or other channels per corner")
+                        ChannelKind::Color if first_of_kind && c.dimension == 3 => None,
+                        ChannelKind::Color if first_of_kind => {
+                            Some("OBJ vertex colours are RGB (no alpha)")
                         }
+                        ChannelKind::Color => Some("OBJ holds one colour per vertex"),
+                        ChannelKind::Generic => Some("OBJ holds no other channels"),
                     }
                 })
                 .collect()

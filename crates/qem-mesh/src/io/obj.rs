@@ -4,14 +4,16 @@
 //! Positions (`v`), faces (`f`), and the mesh's attributes
 //! ([`crate::attributes`]): texture coordinates (`vt`) and normals (`vn`) per corner,
 //! each face's group (`o`/`g`) and material (`usemtl`), and the material files
-//! (`mtllib`, not opened). A corner without a `vt` or `vn` index has none
+//! (`mtllib`, not opened), and vertex colours (`v x y z r g b`, read as 0–1; a file
+//! with a value above 1 is read as 0–255 levels). A corner without a `vt` or `vn` index has none
 //! ([`Channel::MISSING`]): `tobj` would fill it with a neighbour's value, so the reader
 //! marks those corners from its own scan. `l` and `p` elements, points and lines
 //! written as `f` with one or two corners, and smoothing groups are ignored. Polygons
 //! are fan-triangulated from their first corner (as `tobj` does with `triangulate`),
 //! each triangle with its polygon's corners' values and labels.
 //!
-//! The writer writes all of it: `mtllib`, `v`, `vt`, `vn`, then the faces as
+//! The writer writes all of it: `mtllib`, `v` (with its colour; a vertex with colour
+//! seams once per colour, which an exact weld joins again), `vt`, `vn`, then the faces as
 //! `v/vt/vn` corners with a `g` or `usemtl` line wherever the group or material
 //! changes (the first channel of each kind: OBJ has one slot each).
 //!
@@ -673,8 +675,23 @@ fn assemble(models: &[tobj::Model]) -> IndexedMesh {
     mesh.triangles.reserve(tri_total);
     let mut uv = Channel::new(ChannelKind::TexCoord, Vec::new(), Vec::new());
     let mut normal = Channel::new(ChannelKind::Normal, Vec::new(), Vec::new());
+    // `v x y z r g b` colours (tobj refuses a file where only some `v` lines have
+    // them), one per vertex as tobj numbers them.
+    let colours = models
+        .iter()
+        .any(|m| !m.mesh.vertex_color.is_empty())
+        .then(|| {
+            models
+                .iter()
+                .all(|m| m.mesh.vertex_color.len() == m.mesh.positions.len())
+        })
+        == Some(true);
+    let mut colour = Vec::new();
     for m in models {
         let m = &m.mesh;
+        if colours {
+            colour.extend(m.vertex_color.iter().map(|&x| x as f32));
+        }
         let base = mesh.positions.len() as u32;
         mesh.positions
             .extend(m.positions.chunks_exact(3).map(|c| [c[0], c[1], c[2]]));
@@ -700,6 +717,16 @@ fn assemble(models: &[tobj::Model]) -> IndexedMesh {
     if any_norm {
         mesh.attributes.channels.push(normal);
     }
+    if colours {
+        // Some exporters write 0–255 levels: a value above 1 says so.
+        if colour.iter().any(|&c| c > 1.0) {
+            colour.iter_mut().for_each(|c| *c /= 255.0);
+        }
+        let corners = mesh.triangles.clone();
+        mesh.attributes
+            .channels
+            .push(Channel::new(ChannelKind::Color, colour, corners));
+    }
     mesh
 }
 
@@ -718,6 +745,26 @@ pub(crate) fn write(
     mesh: &IndexedMesh,
     comments: &[String],
 ) -> std::io::Result<()> {
+    let attrs = &mesh.attributes;
+    // Colours go on `v` lines, one per vertex: with colour seams (a vertex whose
+    // corners have different colours) its position is written once per colour, which
+    // an exact weld joins again on reading. Texture coordinates and normals are per
+    // corner, so the split leaves them alone.
+    let colour = attrs
+        .channel(ChannelKind::Color)
+        .filter(|c| c.dimension == 3);
+    let split = colour.map(|c| {
+        let only = IndexedMesh::new(mesh.positions.clone(), mesh.triangles.clone())
+            .with_attributes(crate::attributes::Attributes {
+                channels: vec![c.clone()],
+                ..Default::default()
+            });
+        crate::attributes::split_at_seams(&only)
+    });
+    let (positions, triangles) = match &split {
+        Some(s) => (&s.positions, &s.triangles),
+        None => (&mesh.positions, &mesh.triangles),
+    };
     writeln!(out, "# written by qem")?;
     for c in comments {
         writeln!(out, "# {}", super::one_line(c))?;
@@ -725,17 +772,22 @@ pub(crate) fn write(
     writeln!(
         out,
         "# {} vertices, {} triangles",
-        mesh.positions.len(),
-        mesh.triangles.len()
+        positions.len(),
+        triangles.len()
     )?;
-    let attrs = &mesh.attributes;
     for library in &attrs.material_libraries {
         out.write_all(b"mtllib ")?;
         out.write_all(library)?;
         out.write_all(b"\n")?;
     }
-    for [x, y, z] in &mesh.positions {
-        writeln!(out, "v {x} {y} {z}")?;
+    for (v, [x, y, z]) in positions.iter().enumerate() {
+        match &split {
+            Some(s) => {
+                let c = s.attributes.channels[0].value(v as u32);
+                writeln!(out, "v {x} {y} {z} {} {} {}", c[0], c[1], c[2])?;
+            }
+            None => writeln!(out, "v {x} {y} {z}")?,
+        }
     }
     // OBJ has one slot for texture coordinates and one for normals: the first channel
     // of each kind. (Other channels cannot be written in OBJ; the caller's report says
@@ -753,7 +805,7 @@ pub(crate) fn write(
         }
     }
     let (mut group, mut material) = (FaceLabels::NONE, FaceLabels::NONE);
-    for (t, corners) in mesh.triangles.iter().enumerate() {
+    for (t, corners) in triangles.iter().enumerate() {
         for (labels, current, keyword) in [
             (&attrs.groups, &mut group, &b"g"[..]),
             (&attrs.materials, &mut material, &b"usemtl"[..]),

@@ -151,3 +151,27 @@ usemtl a\nf 1/1 1/2 2/3\nf 1/1 2/2 3/3\nusemtl b\nf 2/4 3/4 1/4\nf 2/2 4/4 3/3\n
     assert_eq!(uv.at_corner(1, 1), Some(&[1.0, 1.0][..]));
     assert_eq!(kept.validate(), Ok(()));
 }
+
+#[test]
+fn vertex_colours_on_v_lines_round_trip_and_survive_a_seam() {
+    let obj = b"v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 1 1 0 0 0 1\nv 0 1 0 0.5 0.5 0.5\n\
+vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";
+    let mesh = read_bytes(obj, Format::Obj).unwrap().mesh;
+    let colour = mesh.attributes.channel(ChannelKind::Color).unwrap();
+    assert_eq!(colour.dimension, 3);
+    assert_eq!(colour.at_corner(1, 2), Some(&[0.5, 0.5, 0.5][..]));
+    assert_round_trip("coloured", &mesh);
+    // A colour seam (vertex 0 red on one face, blue on the other): written as two
+    // `v` lines at one position, read back with each face's own colour.
+    let mut seam = mesh.clone();
+    let c = &mut seam.attributes.channels[1];
+    c.values.extend([0.0, 0.0, 1.0]);
+    c.corners[1][0] = 4;
+    assert_eq!(seam.validate(), Ok(()));
+    assert_round_trip("colour seam", &seam);
+    // 0–255 levels (some scanners' OBJ) read as 0–1.
+    let levels = b"v 0 0 0 255 0 0\nv 1 0 0 0 255 0\nv 0 1 0 0 0 51\nf 1 2 3\n";
+    let mesh = read_bytes(levels, Format::Obj).unwrap().mesh;
+    let colour = mesh.attributes.channel(ChannelKind::Color).unwrap();
+    assert_eq!(colour.at_corner(0, 2), Some(&[0.0, 0.0, 0.2][..]));
+}
