@@ -193,16 +193,18 @@ pub fn measure(
     })
 }
 
+/// Checks both meshes ([`IndexedMesh::validate`]), naming the one that fails.
+fn validate_both(a: &IndexedMesh, b: &IndexedMesh) -> Result<(), MeasureError> {
+    for (mesh, which) in [(a, Which::A), (b, Which::B)] {
+        mesh.validate()
+            .map_err(|error| MeasureError::Invalid { mesh: which, error })?;
+    }
+    Ok(())
+}
+
 /// Checks both meshes and returns `a`'s bounding-box diagonal, refused when it is 0.
 fn validated_diagonal(a: &IndexedMesh, b: &IndexedMesh) -> Result<f64, MeasureError> {
-    a.validate().map_err(|error| MeasureError::Invalid {
-        mesh: Which::A,
-        error,
-    })?;
-    b.validate().map_err(|error| MeasureError::Invalid {
-        mesh: Which::B,
-        error,
-    })?;
+    validate_both(a, b)?;
     let diagonal = match a.bounding_box() {
         Some((lo, hi)) => length(sub(hi, lo)),
         None => 0.0,

@@ -13,8 +13,8 @@
 //! charts, and the few such samples dominate the mean square and the maximum.
 
 use super::{
-    closest_point_on_triangle, stream_seed, MeasureError, MeasureOptions, SampleSet, SplitMix64,
-    TriangleBvh, Which, CHUNK,
+    closest_point_on_triangle, stream_seed, validate_both, MeasureError, MeasureOptions, SampleSet,
+    SplitMix64, TriangleBvh, CHUNK,
 };
 use crate::attributes::{Channel, ChannelKind};
 use crate::IndexedMesh;
@@ -71,10 +71,7 @@ pub fn measure_attributes(
     if !(options.samples_per_face.is_finite() && options.samples_per_face >= 0.0) {
         return Err(MeasureError::BadSamplesPerFace(options.samples_per_face));
     }
-    for (mesh, which) in [(a, Which::A), (b, Which::B)] {
-        mesh.validate()
-            .map_err(|error| MeasureError::Invalid { mesh: which, error })?;
-    }
+    validate_both(a, b)?;
     let shared: Vec<(&Channel, &Channel)> = b
         .attributes
         .channels

@@ -65,6 +65,11 @@ pub(super) fn ranked(cost: f64) -> f64 {
 /// frame's half-size, squared.
 const GEOMETRY_SLACK: f64 = 1e-8;
 
+/// How much an attribute-weighted placement may raise the geometric error above the
+/// geometry's own best placement: meshoptimizer's bound on its attribute update (its
+/// `solvePositions`), 1.5.
+const GEOMETRY_GROWTH: f64 = 1.5;
+
 /// How often (in attempted contractions) the observer's progress is called.
 const OBSERVER_INTERVAL: usize = 4096;
 
@@ -724,13 +729,18 @@ impl Engine {
                 }
                 let total = q + attributes;
                 let both = place_merged(&total, ends, self.settings.placement);
+                if ends[0].1 || ends[1].1 {
+                    // Placed at a locked or pinned end: there is no other place.
+                    return (both, q);
+                }
                 // Where the attributes would pull the vertex off the geometry's best
-                // place by more than half its error again, the geometry's place wins
-                // (meshoptimizer's update rule has the same bound, 1.5x): attribute
-                // fields that bend faster than the surface (smooth normals across a
-                // crease) would otherwise trade shape for shading.
+                // place by more than GEOMETRY_GROWTH times its error, the geometry's
+                // place wins: attribute fields that bend faster than the surface
+                // (smooth normals across a crease) would otherwise trade shape for
+                // shading (tm_fuze at 0.5: mean 0.318% without this bound, 0.106%
+                // with it; BENCHMARKS.md, "Attributes").
                 let geometric = place_merged(&q, ends, self.settings.placement);
-                let allowed = 1.5 * geometric.cost + GEOMETRY_SLACK * q.weight();
+                let allowed = GEOMETRY_GROWTH * geometric.cost + GEOMETRY_SLACK * q.weight();
                 if q.evaluate(both.position) <= allowed {
                     (both, q)
                 } else {

@@ -120,15 +120,19 @@ pub(super) fn in_original_order(
         .zip(triangle_from)
         .map(|(t, &from)| (from, t.map(|v| new_number[v as usize])))
         .collect();
-    // With attributes, the permutation itself, to take them along.
-    let attributes = (!mesh.attributes.is_empty()).then(|| {
-        let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
-        order.par_sort_unstable_by_key(|&k| triangles[k as usize].0);
-        mesh.attributes.for_faces(&order)
-    });
-    triangles.par_sort_unstable_by_key(|&(from, _)| from);
-    IndexedMesh::new(positions, triangles.into_iter().map(|(_, t)| t).collect())
-        .with_attributes(attributes.unwrap_or_default())
+    if mesh.attributes.is_empty() {
+        triangles.par_sort_unstable_by_key(|&(from, _)| from);
+        return IndexedMesh::new(positions, triangles.into_iter().map(|(_, t)| t).collect());
+    }
+    // With attributes, one sort of the triangles' places, which orders both them and
+    // their attributes.
+    let mut by_origin: Vec<u32> = (0..triangles.len() as u32).collect();
+    by_origin.par_sort_unstable_by_key(|&k| triangles[k as usize].0);
+    IndexedMesh::new(
+        positions,
+        by_origin.iter().map(|&k| triangles[k as usize].1).collect(),
+    )
+    .with_attributes(mesh.attributes.for_faces(&by_origin))
 }
 
 /// The numbers of `triangles` stably sorted by their lowest corner (a counting sort:
