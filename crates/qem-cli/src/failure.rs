@@ -1,7 +1,21 @@
 //! How a command ends when it does not succeed, and the exit code of each case.
 
 use crate::progress::INTERRUPTED_EXIT;
+use std::io::{ErrorKind, Write};
 use std::process::ExitCode;
+
+/// Writes `text` to standard output. A reader that closed the pipe early (`qem measure
+/// --json | head`) has taken what it wanted: that ends the output quietly, where
+/// `print!` would panic. Any other failure to write is an error.
+pub fn print_stdout(text: &str) -> Result<(), String> {
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() != ErrorKind::BrokenPipe => {
+            Err(format!("cannot write to standard output: {e}"))
+        }
+        _ => Ok(()),
+    }
+}
 
 /// Why a command did not succeed.
 #[derive(Debug)]

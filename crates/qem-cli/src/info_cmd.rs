@@ -1,7 +1,7 @@
 //! `qem info`: what is messy about a mesh, as text or JSON. The counting is
 //! `qem_mesh::inspect`; this module only loads and prints.
 
-use crate::failure::Failure;
+use crate::failure::{print_stdout, Failure};
 use crate::report::InfoJson;
 use clap::Args;
 use qem_mesh::inspect::{inspect, MeshInfo};
@@ -51,11 +51,10 @@ pub fn run(args: &InfoArgs) -> Result<(), Failure> {
     if args.json {
         let json = serde_json::to_string_pretty(&InfoJson::new(&args.input, &info))
             .map_err(|e| Failure::Failed(format!("cannot format the JSON: {e}")))?;
-        println!("{json}");
+        print_stdout(&format!("{json}\n")).map_err(Failure::Failed)
     } else {
-        print!("{}", text(&args.input.display().to_string(), &info));
+        print_stdout(&text(&args.input.display().to_string(), &info)).map_err(Failure::Failed)
     }
-    Ok(())
 }
 
 fn text(name: &str, i: &MeshInfo) -> String {

@@ -1,6 +1,7 @@
 //! `qem measure A B`: Metro-style distance between two mesh files, and the error of
 //! the attribute channels they share.
 
+use crate::failure::print_stdout;
 use clap::Args;
 use qem_mesh::attributes::{Channel, ChannelKind};
 use qem_mesh::io::{read_path, write_path_commented, Format};
@@ -215,14 +216,16 @@ pub fn run(args: &MeasureArgs) -> Result<(), String> {
                 .collect(),
         };
         let text = serde_json::to_string_pretty(&json).map_err(|e| format!("JSON: {e}"))?;
-        println!("{text}");
+        print_stdout(&format!("{text}\n"))
     } else {
-        print!(
-            "{}",
-            human(args, &m, a.triangle_count(), b.triangle_count(), &channels)
-        );
+        print_stdout(&human(
+            args,
+            &m,
+            a.triangle_count(),
+            b.triangle_count(),
+            &channels,
+        ))
     }
-    Ok(())
 }
 
 /// One line per figure, distances in % of A's diagonal.

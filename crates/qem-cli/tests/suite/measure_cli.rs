@@ -176,3 +176,25 @@ fn attribute_error_and_heat_map() {
     ]))
     .contains("use .ply or .off"));
 }
+
+/// A reader that closes the pipe before `qem measure` prints (`qem measure ... | head
+/// -c 0`) ends the output quietly: `print!` used to panic on the broken pipe, with a
+/// backtrace on stderr.
+#[test]
+fn a_closed_pipe_on_stdout_is_no_panic() {
+    use std::process::{Command, Stdio};
+    let spot = spot();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_qem"))
+        .args(["measure", common::s(&spot), common::s(&spot), "--json"])
+        .args(FEW)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("qem starts");
+    // Closed at once: loading and sampling spot take far longer than this.
+    drop(child.stdout.take());
+    let o = child.wait_with_output().expect("qem ends");
+    let err = stderr(&o);
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(o.status.success(), "{err}");
+}
