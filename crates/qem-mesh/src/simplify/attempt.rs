@@ -148,7 +148,15 @@ impl Engine {
             }
             None => self.place(a, b),
         };
-        let error = q.rms_distance(self.geometric_cost(&q, &placed));
+        let mut error = q.rms_distance(self.geometric_cost(&q, &placed));
+        // A part that vanishes costs its size (see `Engine::vanishing_radius`); its
+        // merged faces go with it, and are not asked whether they fold.
+        let vanishes = self.settings.allow_merges && leaves_no_triangle(star);
+        if vanishes {
+            let corners = around.iter().flatten().flat_map(|x| x.corners);
+            error = error.max(farthest_corner(&self.position, corners, placed.position));
+        }
+        let unchecked: &[u32] = if vanishes { merged } else { &[] };
         if error > self.settings.max_error_bound {
             return Attempt::OverErrorBound;
         }
@@ -169,14 +177,14 @@ impl Engine {
             Some(Pin::A) => DVec3::from_array(self.world[a as usize]),
             _ => self.world_position(a, &placed, any_locked),
         };
-        if let Err(why) = self.check(a, b, world, shared, around, merged) {
+        if let Err(why) = self.check(a, b, world, shared, around, [merged, unchecked]) {
             self.counters.reject(why);
             return Attempt::Refused;
         }
         // Last: the only check that searches outside the neighbourhood. A waived pair
         // (refused before, ranked at a penalty since) is taken without it.
         let waived = self.waivers.take(a, b);
-        if !waived && !self.faces_agree_with_input(a, b, world, around, speculation) {
+        if !waived && !self.faces_agree_with_input(a, b, world, around, unchecked, speculation) {
             self.counters.reject(Rejection::Orientation);
             self.waivers.waive(a, b);
             return Attempt::Waived;
@@ -232,7 +240,8 @@ impl Engine {
 
     /// Every check of contracting `b` into `a` at `world` but the orientation check:
     /// fold-over (degenerate, flipped, sliver), merged faces, border loops, topology,
-    /// locks.
+    /// locks. `merged` are the faces the contraction merges away, and `unchecked` those
+    /// of them the fold-over check passes over (see `plain_checks`).
     fn check(
         &self,
         a: u32,
@@ -240,7 +249,7 @@ impl Engine {
         world: DVec3,
         shared: usize,
         around: &[Vec<Around>; 2],
-        merged: &[u32],
+        [merged, unchecked]: [&[u32]; 2],
     ) -> Result<(), Rejection> {
         plain_checks(
             &self.corners_view(),
@@ -249,6 +258,7 @@ impl Engine {
             world,
             shared,
             around,
+            unchecked,
         )?;
         if self.settings.any_locked && self.locked_vertex_would_vanish(a, b, around) {
             return Err(Rejection::Locked);
@@ -272,7 +282,8 @@ impl Engine {
     /// Whether every triangle that contracting `b` into `a` at `world` moves faces the
     /// same way as the input surface nearest to its new centroid (see
     /// [`super::orientation`]); true when the check is off. Triangles on both `a` and
-    /// `b` collapse and are not asked.
+    /// `b` collapse and are not asked, nor are the `unchecked` ones (merged faces of a
+    /// part that vanishes).
     ///
     /// A face that `speculation` found to agree is taken as agreeing when none of its
     /// corners has moved since (see [`speculate`](Self::speculate)); the others are
@@ -283,6 +294,7 @@ impl Engine {
         b: u32,
         world: DVec3,
         around: &[Vec<Around>; 2],
+        unchecked: &[u32],
         speculation: Option<&Speculation>,
     ) -> bool {
         let Some(surface) = self.input_surface.as_mut() else {
@@ -306,7 +318,7 @@ impl Engine {
         let mut neighbour_hint = None;
         let agrees = around.iter().flatten().all(|x| {
             let corners = x.corners;
-            if corners.contains(&a) && corners.contains(&b) {
+            if corners.contains(&a) && corners.contains(&b) || unchecked.contains(&x.triangle) {
                 return true;
             }
             if known.iter().any(|f| f.triangle == x.triangle) {
@@ -376,6 +388,19 @@ pub(super) struct Star<'a> {
     around: &'a [Vec<Around>; 2],
     shared: usize,
     merged: &'a [u32],
+}
+
+/// Whether contracting a pair as `star` says leaves no live triangle at either end:
+/// every triangle there collapses with the pair or merges away (with the ladder's
+/// merges, a part that vanishes).
+fn leaves_no_triangle(star: Star<'_>) -> bool {
+    let Star {
+        around,
+        shared,
+        merged,
+    } = star;
+    // The triangles on both ends are in both lists.
+    around[0].len() + around[1].len() <= 2 * shared + merged.len()
 }
 
 /// What [`Engine::try_contract`] did.

@@ -60,6 +60,26 @@ pub(super) fn ranked(cost: f64) -> f64 {
     }
 }
 
+/// The cost, on the merged quadric `q`, of a contraction that makes a surface reaching
+/// `radius` (normalised units) from the new vertex vanish (see
+/// [`Engine::vanishing_radius`]): the cost at which `q`'s RMS distance
+/// ([`Quadric::rms_distance`]) is that radius, so the order ranks it and the error
+/// bound and the report count it like any other error.
+pub(super) fn removal_cost(radius: f64, q: &Quadric) -> f64 {
+    radius * radius * q.weight().max(0.0)
+}
+
+/// The largest distance from `at` to `corners` (vertex numbers into `position`).
+pub(super) fn farthest_corner(
+    position: &[DVec3],
+    corners: impl Iterator<Item = u32>,
+    at: DVec3,
+) -> f64 {
+    corners
+        .map(|c| position[c as usize].distance(at))
+        .fold(0.0, f64::max)
+}
+
 /// The geometric error (as a squared distance in the normalised frame, times the
 /// quadric's weight) an attribute-weighted placement may always add: 1e-4 of the
 /// frame's half-size, squared.
@@ -116,6 +136,9 @@ pub(super) struct Engine {
     /// The last pass's edges and costs in listing order, and where each vertex's start.
     last_listed: Vec<Candidate>,
     last_listed_first: Vec<u32>,
+    /// Whether the costs of `last_listed` were computed with merges allowed (which
+    /// price a part that vanishes: [`Engine::vanishing_radius`]).
+    last_costed_with_merges: bool,
     /// The candidates whose cost this pass ranks at the waivers' penalty, with their
     /// costs before it (restored before the list becomes `last_listed`).
     unpenalised_costs: Vec<(u32, f64)>,
@@ -254,6 +277,7 @@ impl Engine {
             listed_first: Vec::new(),
             last_listed: Vec::new(),
             last_listed_first: Vec::new(),
+            last_costed_with_merges: false,
             unpenalised_costs: Vec::new(),
             seen_with: vec![u32::MAX; n],
             around: [Vec::new(), Vec::new()],
@@ -666,6 +690,7 @@ impl Engine {
             };
         });
         self.candidates = candidates;
+        self.last_costed_with_merges = self.settings.allow_merges;
         // Waived pairs are ranked at the waivers' penalty on their merged quadric.
         // (Few: a pass lists them first, then reads their quadrics.)
         if self.waivers.is_empty() {
@@ -686,8 +711,13 @@ impl Engine {
     }
 
     /// The cost of the edge `a b` (`a < b`) in the last pass's list, when neither end
-    /// moved in that pass.
+    /// moved in that pass. Never with merges allowed, nor when the last pass allowed
+    /// them: whether a pair makes a part vanish depends on its neighbours' triangles too, and
+    /// is priced only while merges are allowed.
     fn last_cost(&self, a: u32, b: u32) -> Option<f64> {
+        if self.settings.allow_merges || self.last_costed_with_merges {
+            return None;
+        }
         let last = self.pass.checked_sub(1).filter(|&p| p > 0)?;
         if self.moved_in[a as usize] == last || self.moved_in[b as usize] == last {
             return None;
@@ -712,6 +742,18 @@ impl Engine {
     /// geometric and the attribute error together, and a pair that would join a
     /// seam's sides costs +∞); the quadric returned is the geometric one.
     fn place_with(&self, a: u32, b: u32, q: Quadric) -> (Placement, Quadric) {
+        let (mut placed, q) = self.place_on_quadrics(a, b, q);
+        if self.settings.allow_merges {
+            if let Some(radius) = self.vanishing_radius(a, b, placed.position) {
+                placed.cost = placed.cost.max(removal_cost(radius, &q));
+            }
+        }
+        (placed, q)
+    }
+
+    /// [`place_with`](Self::place_with) as the quadrics see it, without the cost of
+    /// a part that vanishes.
+    fn place_on_quadrics(&self, a: u32, b: u32, q: Quadric) -> (Placement, Quadric) {
         let mut ends = [
             (self.position[a as usize], self.locked[a as usize]),
             (self.position[b as usize], self.locked[b as usize]),
@@ -754,6 +796,55 @@ impl Engine {
                 (placed, q)
             }
         }
+    }
+
+    /// With [`Settings::allow_merges`] (the ladder's merged faces), when contracting
+    /// `b` into `a` would leave no live triangle at either end, each triangle there
+    /// collapsing with the pair or merging with its twin (a closed part worn down to a
+    /// tetrahedron vanishes): the largest distance from `at` (normalised units) to a
+    /// corner of those triangles, the size of the surface that vanishes into that point.
+    /// `None` when a triangle is left.
+    ///
+    /// Why: the quadrics measure distance to planes, not coverage. A long thin rod worn
+    /// down to a sliver tetrahedron vanishes at the cost of a point on its axis, almost
+    /// nothing: priced by the quadrics alone, the pass-based order took two rods the
+    /// length of ps_mk4_gantry (1,850 units) out at a quadric error of 0.4% of the
+    /// diagonal, for a Hausdorff distance of 53% (BENCHMARKS.md, "Never stuck").
+    ///
+    /// Why not every merge: pricing the faces any merge removes the same way (tried)
+    /// left more damage, not less (ps_mk4_gantry at 0.01 went from 0.86% to 2.4%, and
+    /// mf_offset1 from 31% to 41%, in the greedy order): the run then takes relaxed
+    /// contractions that the quadrics misprice in other ways.
+    ///
+    /// Every twin is taken as merging; [`Engine::merged_away`] may keep one face of a
+    /// pair (near the target, or a part's last face), so this can only over-price a
+    /// pair for the order; the attempt prices what it removes.
+    fn vanishing_radius(&self, a: u32, b: u32, at: DVec3) -> Option<f64> {
+        let live = |v: u32| {
+            self.incidence
+                .of(v)
+                .iter()
+                .map(|&t| self.triangles[t as usize])
+                .filter(|c| c[0] != REMOVED)
+        };
+        // Every triangle at `from` not on both ends has a twin at `to`: the triangle
+        // with the same two other corners.
+        let all_merge = |from: u32, to: u32| {
+            live(from).all(|c| {
+                c.contains(&to) || {
+                    let mut others = c.into_iter().filter(|&x| x != from);
+                    let (Some(x), Some(y)) = (others.next(), others.next()) else {
+                        return false;
+                    };
+                    live(to).any(|d| !d.contains(&from) && d.contains(&x) && d.contains(&y))
+                }
+            })
+        };
+        if !(all_merge(a, b) && all_merge(b, a)) {
+            return None;
+        }
+        let corners = live(a).chain(live(b)).flatten();
+        Some(farthest_corner(&self.position, corners, at))
     }
 
     /// The geometric part of a placement's cost: the cost itself, or with attributes

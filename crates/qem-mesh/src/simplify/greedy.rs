@@ -50,6 +50,17 @@ impl Engine {
                 break StopReason::NoValidPair;
             };
             let [a, b] = greedy.pairs.ends(id);
+            if self.settings.allow_merges {
+                // Whether a pair makes a part vanish (priced by `place` while merges
+                // are allowed) depends on its neighbours' triangles, which a
+                // contraction elsewhere can change without costing the pair again: it
+                // is costed again here, and queued again if it went up.
+                let fresh = ranked(self.place(a, b).0.cost);
+                if fresh > cost {
+                    greedy.queue.push(id, fresh);
+                    continue;
+                }
+            }
             let virtual_allowed = greedy.virtual_ok[id as usize];
             match self.try_contract(a, b, [live, target], virtual_allowed, None, observer) {
                 Attempt::Contracted {

@@ -111,19 +111,26 @@ impl Corners<'_> {
 
     /// The fold-over check of contracting the
     /// pair `a b` to `world` (model units): every triangle of `around` that moves and
-    /// does not collapse.
+    /// does not collapse, but the `unchecked` ones: the merged faces of a part that
+    /// vanishes, which leave nothing to fold (of two merging faces `a x y` and `b x y`
+    /// on a closed part, the second moved onto the first faces the other way, so the
+    /// check refused every tetrahedron's last contraction on ps_mk4_gantry).
     pub fn fold_over(
         &self,
         fixed: &Fixed,
         [a, b]: [u32; 2],
         world: DVec3,
         around: &[Vec<Around>; 2],
+        unchecked: &[u32],
     ) -> Result<(), Rejection> {
         let moved = fixed.frame.to_normalized(world);
         for x in around.iter().flatten() {
             let corners = x.corners;
             if corners.contains(&a) && corners.contains(&b) {
                 continue; // collapses with the pair
+            }
+            if unchecked.contains(&x.triangle) {
+                continue; // merged away with the part it belonged to
             }
             let old = corners.map(|c| self.position(c));
             let new = std::array::from_fn::<_, 3, _>(|i| {
@@ -465,7 +472,8 @@ pub(super) fn contract_block(
                 DVec3::from_array(slab.world[sa])
             }
         };
-        if let Err(why) = plain_checks(&slab.corners(), fixed, [a, b], world, shared, &around) {
+        if let Err(why) = plain_checks(&slab.corners(), fixed, [a, b], world, shared, &around, &[])
+        {
             out.counters.reject(why);
             continue;
         }
@@ -528,8 +536,9 @@ pub(super) fn contract_block(
 }
 
 /// The checks every contraction passes, in both orders and in the block workers:
-/// fold-over (degenerate, flipped, sliver), merged faces, border loops, topology. (The
-/// lock check and the orientation check are the sequential attempts' own.)
+/// fold-over (degenerate, flipped, sliver; but not of the `unchecked` faces, see
+/// [`Corners::fold_over`]), merged faces, border loops, topology. (The lock check and
+/// the orientation check are the sequential attempts' own.)
 pub(super) fn plain_checks(
     corners: &Corners,
     fixed: &Fixed,
@@ -537,8 +546,9 @@ pub(super) fn plain_checks(
     world: DVec3,
     shared: usize,
     around: &[Vec<Around>; 2],
+    unchecked: &[u32],
 ) -> Result<(), Rejection> {
-    corners.fold_over(fixed, [a, b], world, around)?;
+    corners.fold_over(fixed, [a, b], world, around, unchecked)?;
     if !fixed.settings.allow_merges && would_merge_faces(a, b, around) {
         return Err(Rejection::Merge);
     }

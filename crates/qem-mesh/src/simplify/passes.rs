@@ -81,6 +81,21 @@ const SPECULATION_MIN_LEN: usize = 16;
 /// 5, alternating); the check's promise is worth more.
 pub(super) const BATCH_COST_FACTOR: f64 = 1.5;
 
+/// When a pass's batch had to grow (none of its cheapest pairs could be contracted),
+/// the pass contracts the grown batch's pairs cheapest first and only up to this factor
+/// times the cost of the first one it contracts; the rest wait for the next pass, which
+/// costs them again.
+///
+/// Why: the batch grows fourfold at a time, and near the end of a stuck run that is
+/// every pair left; contracting all of them in list order took whatever could move,
+/// however costly, before the cheap pairs those contractions opened up. On ps_mk4_gantry
+/// at ratio 0.01 (the ladder's merges, where a part worn down to a tetrahedron may
+/// vanish), one grown pass took two rods as long as the model out (Hausdorff distance
+/// 53% of the diagonal) while small parts were still there to go; the greedy order,
+/// cheapest first, never did. The factor is [`BATCH_COST_FACTOR`]'s, for the same
+/// reason: the pairs just above the cheapest are about as good.
+const GROWN_BATCH_COST_FACTOR: f64 = BATCH_COST_FACTOR;
+
 /// The order candidates are taken in: cost, then [`scatter`] of the index in the
 /// pass's list. A total order (NaN costs are stored as +∞, see
 /// [`Engine::cost_edges`]; `scatter` is a bijection).
@@ -305,6 +320,10 @@ impl Engine {
         let mut waived = 0;
         let mut end = None;
         let mut over_bound = false;
+        // Once the batch has grown (nothing in it could be contracted), the cost up to
+        // which this pass contracts: set by its first contraction (see `GROWN_BATCH_COST_FACTOR`).
+        let mut grown = false;
+        let mut cost_cap = f64::INFINITY;
         let mut selected = std::mem::take(&mut self.selected);
         let mut speculations = Vec::new();
         let mut batch = std::mem::take(&mut self.batch);
@@ -327,6 +346,7 @@ impl Engine {
                     break;
                 }
                 take = take.saturating_mul(4).min(edges);
+                grown = true;
                 self.list_batch(take, &mut batch);
                 let tried = &self.tried;
                 batch.retain(|&i| !tried[i as usize]);
@@ -334,9 +354,10 @@ impl Engine {
             }
             self.select_local_minima(&batch, &mut selected);
             let may_reach_target = selected.len() * 2 >= live_count - target;
-            if may_reach_target {
+            if may_reach_target || grown {
                 // The round may reach the target: the cheapest first, so that the
-                // ones left out are the costliest, not the last in vertex order.
+                // ones left out are the costliest, not the last in vertex order. (A
+                // grown batch: the cheapest first, up to the cost cap.)
                 let candidates = &self.candidates;
                 selected.sort_unstable_by(|&x, &y| {
                     cheaper((&candidates[x as usize], x), (&candidates[y as usize], y))
@@ -350,11 +371,12 @@ impl Engine {
             let blocks_in_order = self.probes.blocks_in_order;
             #[cfg(not(test))]
             let blocks_in_order = false;
-            let attempts = if !may_reach_target && self.uses_blocks() && blocks_in_order {
+            let in_order = may_reach_target || grown;
+            let attempts = if !in_order && self.uses_blocks() && blocks_in_order {
                 #[cfg(test)]
                 self.interior_first(&selected, &mut deferred);
                 &deferred
-            } else if !may_reach_target && self.uses_blocks() {
+            } else if !in_order && self.uses_blocks() {
                 let blocks = self.contract_blocks(&selected, &mut deferred, observer);
                 live_count -= blocks.removed;
                 contracted += blocks.contracted;
@@ -393,7 +415,10 @@ impl Engine {
                 let speculation = speculations
                     .get(k % SPECULATION_CHUNK)
                     .and_then(Option::as_ref);
-                let Candidate { a, b, .. } = self.candidates[i as usize];
+                let Candidate { a, b, cost } = self.candidates[i as usize];
+                if cost > cost_cap {
+                    continue; // (in cost order: so is every pair after it in the round)
+                }
                 // A pair on no common triangle is attempted as a virtual pair only in
                 // a run that has them: an edge whose faces a merge took earlier in the
                 // round is none.
@@ -410,6 +435,9 @@ impl Engine {
                         live_count -= removed;
                         contracted += 1;
                         self.chunk_contracted += 1;
+                        if grown && contracted == 1 {
+                            cost_cap = cost.max(0.0) * GROWN_BATCH_COST_FACTOR;
+                        }
                     }
                     Attempt::Refused | Attempt::NotAPair => {}
                     Attempt::Waived => waived += 1,
