@@ -104,7 +104,7 @@ def test_default_options_round_trip(sphere):
 
 def test_default_options_are_the_libraries():
     d = qem.default_options()
-    assert d["ratio"] == 0.5 and d["order"] == "greedy" and d["quadrics"] == "exact"
+    assert d["ratio"] == 0.5 and d["order"] == "passes" and d["quadrics"] == "exact"
     f = qem.default_options(fast=True)
     assert f["order"] == "passes" and f["quadrics"] == "sum"
     assert f["orientation_check"] is False and f["placement"] == "solve_first"

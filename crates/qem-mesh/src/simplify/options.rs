@@ -155,23 +155,22 @@ pub enum VirtualPairs {
 pub enum ContractionOrder {
     /// Garland–Heckbert's: always the cheapest pair next (a heap of every edge and
     /// virtual pair), the pairs at the new vertex re-costed after every contraction.
-    /// A refused pair waits until one of its ends moves. The default: with the other
-    /// defaults it takes about 2.5 times as long as [`Passes`](Self::Passes), and it
-    /// is as accurate on clean scans and more accurate on messy input (BENCHMARKS.md,
-    /// "Passes with every default option").
+    /// A refused pair waits until one of its ends moves. With the other defaults it
+    /// takes about 2.5 times as long as [`Passes`](Self::Passes), for the same accuracy
+    /// (BENCHMARKS.md, "Passes with every default option", "Which order is the
+    /// default").
     Greedy,
     /// meshoptimizer's: in passes, each costing every pair once and contracting a batch
     /// of the cheapest, no two sharing a vertex (a pair whose cost fell during a pass
-    /// waits for the next one). With the other defaults, against
-    /// [`Greedy`](Self::Greedy) (BENCHMARKS.md, "Passes with every default option"):
-    /// about 0.4 times the time; on the 9 clean corpus scans as accurate (mean error at
-    /// most the best of five peers' in 23 of 27 cases against 22, Hausdorff distance in
-    /// 15 against 15, no face facing away at 0.1); on 40 messy corpus meshes a 6.6%
-    /// larger Hausdorff distance (geometric mean of 80 runs), and on ps_mk4_gantry at 0.01 a
-    /// whole part lost (53% of the diagonal against 1.0%). A pair the orientation check
-    /// refuses is ranked at the waivers' penalty in
-    /// later passes and tried without the check next time, unless one of its ends moves
-    /// first. With a [`max_error`](SimplifyOptions::max_error) bound, a pair over the
+    /// waits for the next one). The default. With the other defaults, against
+    /// [`Greedy`](Self::Greedy) (BENCHMARKS.md, "Passes with every default option",
+    /// "Which order is the default"): about 0.4 times the time; on the 9 clean corpus
+    /// scans as accurate (mean error at most the best of five peers' in 23 of 27 cases
+    /// against 22, Hausdorff distance in 15 against 15, no face facing away at 0.1); on
+    /// 40 messy corpus meshes the same (geometric means of 80 runs, Hausdorff distance
+    /// 1.000x, mean distance 1.010x). A pair the orientation check refuses is ranked at
+    /// the waivers' penalty in later passes and tried without the check next time,
+    /// unless one of its ends moves first. With a [`max_error`](SimplifyOptions::max_error) bound, a pair over the
     /// bound is never contracted but does not end the run either; the run stops with
     /// [`StopReason::MaxErrorReached`](super::StopReason::MaxErrorReached) when a pass
     /// contracts nothing and met at least one pair over the bound (and with
@@ -267,7 +266,7 @@ pub struct SimplifyOptions {
     pub locked_vertices: Vec<u32>,
     /// The cleaning passes run before simplification. Default: `CleanOptions::DEFAULT`.
     pub clean: CleanOptions,
-    /// In which order pairs are contracted. Default: `ContractionOrder::Greedy`.
+    /// In which order pairs are contracted. Default: `ContractionOrder::Passes`.
     pub order: ContractionOrder,
     /// Stop when no pair passes every check, rather than climb the ladder of
     /// relaxations ([`RelaxationStep`](super::RelaxationStep)): the run then stops
@@ -421,7 +420,7 @@ impl SimplifyOptions {
         preserve_topology: false,
         locked_vertices: Vec::new(),
         clean: CleanOptions::DEFAULT,
-        order: ContractionOrder::Greedy,
+        order: ContractionOrder::Passes,
         strict: false,
         method: Method::Contraction,
         attribute_weights: AttributeWeights::DEFAULT,

@@ -167,7 +167,7 @@ def simplify(
     preserve_topology: bool = False,
     locked_vertices: Sequence[int] | npt.NDArray[np.integer[Any]] = (),
     clean: CleanOptions | None = None,
-    order: Literal["greedy", "passes"] = "greedy",
+    order: Literal["greedy", "passes"] = "passes",
     strict: bool = False,
     method: Literal["contraction", "clustering"] = "contraction",
     attribute_weights: AttributeWeights | None = {"uv": 0.3, "normal": 0.15, "colour": 1.0, "generic": 1.0},
