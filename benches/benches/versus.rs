@@ -14,7 +14,8 @@
 //!   With `--fast`, `SimplifyOptions::FAST` instead (summed quadrics, no orientation
 //!   check, the solve's point), reported as `qem --fast`; `--orientation-check` and
 //!   `--exact` (with `--fast`) turn on the orientation check and exact quadrics.
-//!   `--passes` runs the defaults in the pass-based order (`qem --order passes`);
+//!   `--greedy` runs the defaults in the greedy order (`qem --order greedy`; the
+//!   default order is the pass-based one);
 //!   `--cluster` runs `SimplifyOptions::CLUSTER` (vertex clustering; its phases print
 //!   as setup = the grid's search, contract = the clustering) against
 //!   `meshopt::simplify_sloppy`, reported as `meshopt sloppy`.
@@ -93,14 +94,14 @@ struct Args {
     orientation_check: bool,
     /// With `fast`, exact quadrics.
     exact: bool,
-    /// The defaults in `ContractionOrder::Passes` (not with `fast`).
-    passes: bool,
+    /// The defaults in `ContractionOrder::Greedy` (not with `fast`).
+    greedy: bool,
     /// qem's vertex clustering against `meshopt::simplify_sloppy`.
     cluster: bool,
 }
 
 const USAGE: &str = "usage: versus [--input dragon|soup|sphere:N|PATH]... [--ratios R,R...] \
-                     [--runs K] [--tool both|qem|meshopt|none|prep] [--fast [--orientation-check] [--exact] | --passes | --cluster]";
+                     [--runs K] [--tool both|qem|meshopt|none|prep] [--fast [--orientation-check] [--exact] | --greedy | --cluster]";
 
 fn parse_args() -> Result<Args, String> {
     let mut args = Args {
@@ -111,7 +112,7 @@ fn parse_args() -> Result<Args, String> {
         fast: false,
         orientation_check: false,
         exact: false,
-        passes: false,
+        greedy: false,
         cluster: false,
     };
     let mut it = std::env::args().skip(1);
@@ -150,7 +151,7 @@ fn parse_args() -> Result<Args, String> {
             "--fast" => args.fast = true,
             "--orientation-check" => args.orientation_check = true,
             "--exact" => args.exact = true,
-            "--passes" => args.passes = true,
+            "--greedy" => args.greedy = true,
             "--cluster" => args.cluster = true,
             "-h" | "--help" => return Err(USAGE.to_string()),
             other => return Err(format!("unknown argument {other:?}\n{USAGE}")),
@@ -161,14 +162,14 @@ fn parse_args() -> Result<Args, String> {
             "--orientation-check and --exact need --fast\n{USAGE}"
         ));
     }
-    if [args.passes, args.fast, args.cluster]
+    if [args.greedy, args.fast, args.cluster]
         .iter()
         .filter(|&&x| x)
         .count()
         > 1
     {
         return Err(format!(
-            "--passes, --fast and --cluster exclude each other\n{USAGE}"
+            "--greedy, --fast and --cluster exclude each other\n{USAGE}"
         ));
     }
     if args.inputs.is_empty() {
@@ -374,8 +375,8 @@ fn qem_options(args: &Args, target: usize) -> SimplifyOptions {
             })
     } else if args.cluster {
         SimplifyOptions::CLUSTER
-    } else if args.passes {
-        SimplifyOptions::DEFAULT.with_order(ContractionOrder::Passes)
+    } else if args.greedy {
+        SimplifyOptions::DEFAULT.with_order(ContractionOrder::Greedy)
     } else {
         SimplifyOptions::DEFAULT
     };
@@ -507,7 +508,7 @@ fn run() -> Result<(), String> {
             let (qem, meshopt) = (qem.measured(), meshopt.measured());
             let qem_name = match (args.fast, args.orientation_check, args.exact) {
                 (false, ..) if args.cluster => "qem --cluster",
-                (false, ..) if args.passes => "qem --order passes",
+                (false, ..) if args.greedy => "qem --order greedy",
                 (false, ..) => "qem",
                 (true, false, false) => "qem --fast",
                 (true, true, false) => "qem --fast --orientation-check",
