@@ -65,7 +65,7 @@ pub(super) fn ranked(cost: f64) -> f64 {
 /// [`Engine::vanishing_radius`]): the cost at which `q`'s RMS distance
 /// ([`Quadric::rms_distance`]) is that radius, so the order ranks it and the error
 /// bound and the report count it like any other error.
-pub(super) fn removal_cost(radius: f64, q: &Quadric) -> f64 {
+pub(super) fn vanishing_cost(radius: f64, q: &Quadric) -> f64 {
     radius * radius * q.weight().max(0.0)
 }
 
@@ -745,7 +745,7 @@ impl Engine {
         let (mut placed, q) = self.place_on_quadrics(a, b, q);
         if self.settings.allow_merges {
             if let Some(radius) = self.vanishing_radius(a, b, placed.position) {
-                placed.cost = placed.cost.max(removal_cost(radius, &q));
+                placed.cost = placed.cost.max(vanishing_cost(radius, &q));
             }
         }
         (placed, q)
