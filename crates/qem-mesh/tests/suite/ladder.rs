@@ -311,7 +311,7 @@ fn a_long_part_does_not_vanish_before_small_ones() {
 
 /// ps_mk4_gantry (a CAD soup of 117 parts, several of them long rods) at ratio 0.01
 /// climbs to the ladder's merged faces in both orders; no part as long as the model
-/// may vanish on the way. The pass-based order, whose batch grows to every pair left
+/// may vanish on the way, and the parts that do vanish go smallest first. The pass-based order, whose batch grows to every pair left
 /// when its cheapest pairs are all refused, took two such rods out in one pass
 /// (Hausdorff distance 53% of the diagonal) before its grown batches were contracted
 /// cheapest first up to a cost cap.
@@ -339,7 +339,9 @@ fn the_gantry_keeps_its_rods_at_one_percent() {
             ..MeasureOptions::DEFAULT
         };
         let m = measure(&mesh, &out.mesh, &few).expect("measures");
-        // Measured at 0.78% (greedy) and 0.88% (passes); meshoptimizer's 52.9%.
-        assert!(m.hausdorff < 0.02, "{what}: Hausdorff {}", m.hausdorff);
+        // Measured at 0.86% (greedy) and 0.87% (passes); meshoptimizer's 52.9%. Greedy
+        // read 1.28% while it did not cost a pair again when popping it (a contraction
+        // elsewhere had made it a vanishing one).
+        assert!(m.hausdorff < 0.012, "{what}: Hausdorff {}", m.hausdorff);
     }
 }
