@@ -1,4 +1,5 @@
-//! `read_obj`, `read_ply`, `read_stl`, `read_off`: arbitrary bytes through a reader.
+//! `read_obj`, `read_ply`, `read_stl`, `read_off`, `read_gltf`: arbitrary bytes through a
+//! reader.
 
 use qem_mesh::attributes::ChannelKind;
 use qem_mesh::io::{read_bytes, write_to, Format};
@@ -22,6 +23,18 @@ pub fn read_stl(data: &[u8]) {
 /// `read_off`: see [`read_checked`].
 pub fn read_off(data: &[u8]) {
     read_checked(data, Format::Off);
+}
+
+/// `read_gltf`: bytes that start with the GLB magic `glTF` are read and written back as
+/// `.glb`, any others as `.gltf` (JSON). The reader itself goes by the content, so the
+/// choice only decides which container the round trip writes; see [`read_checked`].
+pub fn read_gltf(data: &[u8]) {
+    let format = if data.starts_with(b"glTF") {
+        Format::Glb
+    } else {
+        Format::Gltf
+    };
+    read_checked(data, format);
 }
 
 /// Arbitrary bytes give a mesh that passes validation or an error whose message is one
