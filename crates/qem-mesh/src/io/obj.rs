@@ -31,9 +31,11 @@
 //! "absent"). So the reader first scans the bytes itself and reports, with the line:
 //! bytes that are not UTF-8 on a `v`, `vt`, `vn`, `f` or `l` line, `v` lines without
 //! three numbers or with a non-finite coordinate or a zero `w`, `vt` and `vn` lines
-//! without enough numbers, and every face index that is not an integer, is 0, points
-//! before the first element or past the last one of its list. Whatever `tobj` still
-//! refuses is reported with its own message and no line.
+//! without enough numbers, a texture coordinate, normal or vertex colour that is not a
+//! finite 32-bit float (NaN, or beyond float32: attributes are kept as `f32`), and
+//! every face index that is not an integer, is 0, points before the first element or
+//! past the last one of its list. Whatever `tobj` still refuses is reported with its
+//! own message and no line.
 //!
 //! # Lenient where the geometry is not at stake
 //! Everything else may hold any bytes: comments, names and unknown lines. `tobj` reads
@@ -345,7 +347,8 @@ fn prescan(bytes: &[u8], detailed: bool) -> Result<Scan, ReadError> {
                 let first = extra.next();
                 let n_extra = usize::from(first.is_some()) + extra.count();
                 match (n_extra, first) {
-                    (0 | 3, _) => {}
+                    (0, _) => {}
+                    (3, _) => check_f32(words(rest).skip(3), at, || format!("vertex {v}: colour"))?,
                     (_, Some(w)) if n_extra == 1 => {
                         if parse_f64(w).is_none_or(|w| w == 0.0 || !w.is_finite()) {
                             return Err(ReadError::malformed(
@@ -368,11 +371,15 @@ fn prescan(bytes: &[u8], detailed: bool) -> Result<Scan, ReadError> {
                 so_far.v += 1;
             }
             b"vt" => {
-                numbers(2, "texture coordinate", so_far.vt)?;
+                let index = so_far.vt;
+                numbers(2, "texture coordinate", index)?;
+                check_f32(words(rest).take(2), at, || format!("texture coordinate {index}"))?;
                 so_far.vt += 1;
             }
             b"vn" => {
-                numbers(3, "normal", so_far.vn)?;
+                let index = so_far.vn;
+                numbers(3, "normal", index)?;
+                check_f32(words(rest).take(3), at, || format!("normal {index}"))?;
                 so_far.vn += 1;
             }
             b"f" | b"l" => {
@@ -430,6 +437,26 @@ fn prescan(bytes: &[u8], detailed: bool) -> Result<Scan, ReadError> {
         }
     }
     Ok(scan)
+}
+
+/// Refuses the first of `tokens` (numbers, already checked) that is not a finite
+/// `f32`: texture coordinates, normals and colours are kept as `f32`, so a NaN, an
+/// infinity or a value beyond float32 (`1e39`) would be refused by the mesh's
+/// validation, which cannot name the line. `what` names the element for the message.
+fn check_f32<'a>(
+    tokens: impl Iterator<Item = &'a [u8]>,
+    at: Location,
+    what: impl Fn() -> String,
+) -> Result<(), ReadError> {
+    for tok in tokens {
+        if parse_f64(tok).is_some_and(|x| !(x as f32).is_finite()) {
+            return Err(ReadError::malformed(
+                at,
+                format!("{}: {} is not a finite 32-bit float", what(), show(tok)),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Whether a face line's corners are all `a[/[b][/c]]` with positive indices of at
