@@ -39,7 +39,12 @@
 //!   extensions and `KHR_mesh_quantization` are fine); node graphs that are not trees;
 //!   external buffer files when reading from memory ([`super::read_bytes`] cannot
 //!   resolve them; [`super::read_path`] reads them relative to the `.gltf` file, and
-//!   refuses absolute paths and URLs).
+//!   refuses absolute paths and URLs); a buffer that holds less than its
+//!   `byteLength` (a `data:` URI's length is checked before it is decoded, and a
+//!   buffer file is read no further than the declared length, so a size the file only
+//!   claims is never allocated); accessors, buffer views and indices that reach past
+//!   what is there; a NaN or infinite value in a float accessor, naming the accessor
+//!   and the element (positions, normals, texture coordinates and colours alike).
 //! - **Lenient:** a `POSITION` accessor without the `min`/`max` the specification asks
 //!   for is accepted (qem does not use them).
 //!
@@ -80,8 +85,9 @@ use crate::attributes::{Attributes, Channel, ChannelKind, FaceLabels};
 use crate::{IndexedMesh, MAX_ELEMENTS};
 
 /// Opens an external buffer for [`read`]: given its URI (percent-decoded, a relative
-/// path) and the byte count the file declares, gives at least that many bytes.
-pub(crate) type External<'a> = &'a dyn Fn(&str, usize) -> Result<Vec<u8>, ReadError>;
+/// path) and the byte count the glTF declares, gives at most that many bytes (fewer
+/// when the file is shorter, which [`read`] reports with the buffer's index).
+pub(crate) type External<'a> = &'a dyn Fn(&str, usize) -> std::io::Result<Vec<u8>>;
 
 /// The GLB magic, chunk types and the header sizes.
 const GLB_MAGIC: &[u8; 4] = b"glTF";
@@ -275,14 +281,24 @@ fn document(json_text: &[u8]) -> Result<Root, ReadError> {
     Ok(root)
 }
 
+/// Base64 text without its padding (`=` or `==` at the end).
+fn unpadded(text: &[u8]) -> &[u8] {
+    text.strip_suffix(b"==")
+        .or(text.strip_suffix(b"="))
+        .unwrap_or(text)
+}
+
+/// How many bytes [`decode_base64`] gives for `text` when it is valid, found without
+/// decoding: each character carries 6 bits, and a partial byte at the end is dropped.
+fn decoded_len(text: &[u8]) -> usize {
+    unpadded(text).len() / 4 * 3 + unpadded(text).len() % 4 * 3 / 4
+}
+
 /// Decodes standard or URL-safe base64, with or without padding; `None` on any other
 /// byte.
 fn decode_base64(text: &[u8]) -> Option<Vec<u8>> {
-    let text = text
-        .strip_suffix(b"==")
-        .or(text.strip_suffix(b"="))
-        .unwrap_or(text);
-    let mut out = Vec::with_capacity(text.len() / 4 * 3 + 2);
+    let text = unpadded(text);
+    let mut out = Vec::with_capacity(decoded_len(text));
     let (mut acc, mut bits) = (0u32, 0u32);
     for &c in text {
         let v = match c {
@@ -381,6 +397,16 @@ fn load_buffers(
             continue;
         }
         let declared = usize::try_from(buffer.byte_length.0).unwrap_or(usize::MAX);
+        let short = |held: usize| {
+            ReadError::new(
+                ReadErrorKind::Truncated {
+                    detail: format!(
+                        "in buffer {i}: it holds {held} bytes, its byteLength says {declared}"
+                    ),
+                },
+                None,
+            )
+        };
         let data = match buffer.uri.as_deref() {
             None => bin
                 .ok_or_else(|| {
@@ -395,6 +421,12 @@ fn load_buffers(
                     return Err(malformed(format!(
                         "buffer {i}: a data URI that is not base64 ({header:?})"
                     )));
+                }
+                // Refused before decoding when the text is too short for the declared
+                // length, so a short URI that claims 10^9 bytes costs nothing.
+                let held = decoded_len(payload.as_bytes());
+                if held < declared {
+                    return Err(short(held));
                 }
                 decode_base64(payload.as_bytes()).ok_or_else(|| {
                     malformed(format!("buffer {i}: the data URI is not valid base64"))
@@ -419,19 +451,20 @@ fn load_buffers(
                         "buffer {i}: the URI {uri:?} is not a relative file path"
                     )));
                 }
-                open(&path, declared)?
+                open(&path, declared).map_err(|e| {
+                    ReadError::new(
+                        ReadErrorKind::BufferFile {
+                            buffer: i,
+                            uri: path.clone(),
+                            detail: e.to_string(),
+                        },
+                        None,
+                    )
+                })?
             }
         };
         if data.len() < declared {
-            return Err(ReadError::new(
-                ReadErrorKind::Truncated {
-                    detail: format!(
-                        "in buffer {i}: it holds {} bytes, its byteLength says {declared}",
-                        data.len()
-                    ),
-                },
-                None,
-            ));
+            return Err(short(data.len()));
         }
         let mut data = data;
         data.truncate(declared);
@@ -442,6 +475,8 @@ fn load_buffers(
 
 /// An accessor's elements, checked to lie within its buffer view and buffer.
 struct Elements<'b> {
+    /// The accessor for messages: `accessor 3 (NORMAL of mesh 0 primitive 1)`.
+    name: String,
     /// From the first element's first byte to the last element's last byte.
     data: &'b [u8],
     count: usize,
@@ -534,6 +569,7 @@ fn elements<'b>(
         )));
     };
     Ok(Elements {
+        name: format!("accessor {i} ({what})"),
         data: &buffer[start as usize..end as usize],
         count: count as usize,
         stride,
@@ -576,6 +612,22 @@ impl Elements<'_> {
             }
         }
         out
+    }
+
+    /// [`Self::floats`], refusing a value that is not finite (NaN or an infinity in a
+    /// float accessor) with the accessor and the element: the mesh's validation would
+    /// refuse it too, but could not say where it came from.
+    fn finite_floats(&self) -> Result<Vec<f32>, ReadError> {
+        let v = self.floats();
+        match v.iter().position(|x| !x.is_finite()) {
+            Some(k) => Err(malformed(format!(
+                "{}: element {} holds {}, not a finite number",
+                self.name,
+                k / self.components,
+                v[k]
+            ))),
+            None => Ok(v),
+        }
     }
 
     /// The elements as vertex indices (unsigned integer scalars).
@@ -991,7 +1043,7 @@ fn read_positions(
         return Err(malformed(format!("{what}: POSITION must be VEC3")));
     }
     let mut positions = Vec::with_capacity(pos.count);
-    for (v, c) in pos.floats().chunks_exact(3).enumerate() {
+    for (v, c) in pos.finite_floats()?.chunks_exact(3).enumerate() {
         let p = placed
             .world
             .transform_point3(DVec3::new(c[0].into(), c[1].into(), c[2].into()));
@@ -1033,7 +1085,7 @@ fn read_attribute(
             e.components
         )));
     }
-    let mut v = e.floats();
+    let mut v = e.finite_floats()?;
     match key {
         Key::TexCoord(_) => {
             for uv in v.chunks_exact_mut(2) {
@@ -1043,10 +1095,17 @@ fn read_attribute(
         // Untransformed normals are kept bit for bit, so a round trip through glTF
         // does not renormalise them.
         Key::Normal if normal_matrix != DMat3::IDENTITY => {
-            for n in v.chunks_exact_mut(3) {
+            for (k, n) in v.chunks_exact_mut(3).enumerate() {
                 let m = normal_matrix * DVec3::new(n[0].into(), n[1].into(), n[2].into());
-                let m = m.try_normalize().unwrap_or(m);
-                n.copy_from_slice(&m.as_vec3().to_array());
+                // A normal too long to normalise (its squared length overflows) stays
+                // as it is, and may then be beyond float32.
+                let m = m.try_normalize().unwrap_or(m).as_vec3();
+                if !m.is_finite() {
+                    return Err(malformed(format!(
+                        "{what}: NORMAL element {k} is not finite after its node's transform"
+                    )));
+                }
+                n.copy_from_slice(&m.to_array());
             }
         }
         _ => {}
@@ -1422,6 +1481,10 @@ mod tests {
         assert_eq!(encode_base64(b"Man"), "TWFu");
         assert_eq!(decode_base64(b"TWE"), Some(b"Ma".to_vec()));
         assert_eq!(decode_base64(b"TW!u"), None);
+        for text in ["", "T", "TW", "TWE", "TWFu", "TWFuTQ", "TWFuTQ==", "TWFuTWE="] {
+            let decoded = decode_base64(text.as_bytes()).unwrap();
+            assert_eq!(decoded_len(text.as_bytes()), decoded.len(), "{text}");
+        }
     }
 
     #[test]

@@ -7,7 +7,14 @@
 //! The expected messages are exact, so a change of wording is a deliberate change of
 //! this test.
 
-use qem_mesh::io::read_path;
+use std::path::Path;
+
+use qem_mesh::attributes::{Channel, ChannelKind};
+use qem_mesh::io::{read_path, Format};
+use qem_mesh::IndexedMesh;
+use serde_json::{json, Value};
+
+use crate::attributes_common::{encode, glb};
 
 /// Writes `files` (name, content) into a fresh directory, reads the first through
 /// `read_path`, and checks that it is refused with exactly `PATH: CAUSE` on one line.
@@ -139,4 +146,181 @@ fn ply_nan_normals_and_colours_name_the_element_and_property() {
         face_colour,
         "line 16: face 0: property \"green\" is \"inf\", not a finite 32-bit float",
     );
+}
+
+/// A triangle with texture coordinates and normals as the glTF writer writes it, as
+/// its JSON document and its binary buffer: accessor 0 is POSITION (bytes 0..36),
+/// 1 TEXCOORD_0 (36..60), 2 NORMAL (60..96), 3 the indices (96..108).
+fn triangle_gltf() -> (Value, Vec<u8>) {
+    let triangles = vec![[0, 1, 2]];
+    let uv = Channel::new(
+        ChannelKind::TexCoord,
+        vec![0.0, 0.0, 1.0, 0.0, 0.0, 1.0],
+        triangles.clone(),
+    );
+    let normal = Channel::new(
+        ChannelKind::Normal,
+        vec![0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0],
+        triangles.clone(),
+    );
+    let mut mesh = IndexedMesh::new(
+        vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        triangles,
+    );
+    mesh.attributes.channels = vec![uv, normal];
+    let file = encode(&mesh, Format::Glb);
+    let u32_at = |at: usize| u32::from_le_bytes([file[at], file[at + 1], file[at + 2], file[at + 3]]);
+    let json_len = u32_at(12) as usize;
+    let doc = serde_json::from_slice(&file[20..20 + json_len])
+        .unwrap_or_else(|e| panic!("the writer's JSON: {e}"));
+    let bin_len = u32_at(20 + json_len) as usize;
+    let bin = file[28 + json_len..28 + json_len + bin_len].to_vec();
+    assert_eq!(bin.len(), 108, "the layout this test's offsets assume");
+    (doc, bin)
+}
+
+/// `doc` as `.gltf` text.
+fn text(doc: &Value) -> Vec<u8> {
+    serde_json::to_vec(doc).unwrap_or_else(|e| panic!("JSON: {e}"))
+}
+
+#[test]
+fn gltf_external_buffer_missing_or_short_names_the_buffer_and_accessor() {
+    let (mut doc, bin) = triangle_gltf();
+    doc["buffers"][0]["uri"] = json!("tri.bin");
+    assert_refused(
+        "missing_buffer.gltf",
+        &text(&doc),
+        "buffer 0: cannot read its file \"tri.bin\": No such file or directory (os error 2)",
+    );
+    assert_refused_among(
+        &[("short_buffer.gltf", &text(&doc)), ("tri.bin", &bin[..50])],
+        "unexpected end of file in buffer 0: it holds 50 bytes, its byteLength says 108",
+    );
+    // The file holds all the buffer declares, but the buffer is too short for what its
+    // views and accessors claim (accessors 1 and 2 end past byte 50; the attributes are
+    // read in glTF's order of semantics, NORMAL first).
+    doc["buffers"][0]["byteLength"] = json!(50);
+    assert_refused_among(
+        &[("short_view.gltf", &text(&doc)), ("tri.bin", &bin[..50])],
+        "accessor 2 (NORMAL of mesh 0 primitive 0): its buffer view ends past the 50 bytes \
+         of buffer 0",
+    );
+    let (mut doc, _) = triangle_gltf();
+    doc["accessors"][0]["count"] = json!(4);
+    doc["buffers"][0]["uri"] = json!("tri.bin");
+    assert_refused_among(
+        &[("long_accessor.gltf", &text(&doc)), ("tri.bin", &bin)],
+        "accessor 0 (POSITION of mesh 0 primitive 0): 4 elements of 12 bytes do not fit in \
+         its buffer view",
+    );
+}
+
+#[test]
+fn gltf_data_uri_declaring_1e9_bytes_is_refused_before_it_is_decoded() {
+    let (mut doc, _) = triangle_gltf();
+    let billion = 1_000_000_000u64;
+    // The writer's own short URI, with a byteLength of 10^9.
+    let uri = |payload: &str| format!("data:application/octet-stream;base64,{payload}");
+    doc["buffers"][0]["uri"] = json!(uri("AAAA"));
+    doc["buffers"][0]["byteLength"] = json!(billion);
+    assert_refused(
+        "short_uri.gltf",
+        &text(&doc),
+        "unexpected end of file in buffer 0: it holds 3 bytes, its byteLength says \
+         1000000000",
+    );
+    // A genuinely long URI (16 MiB of base64, 12 MiB of zeros): its length is checked
+    // against the declared one without decoding it, and nothing of 10^9 bytes is
+    // reserved (libFuzzer's -malloc_limit_mb would catch that in the read_gltf seed
+    // `data_uri_declares_1e9_bytes_gltf`).
+    doc["buffers"][0]["uri"] = json!(uri(&"A".repeat(1 << 24)));
+    assert_refused(
+        "long_uri.gltf",
+        &text(&doc),
+        "unexpected end of file in buffer 0: it holds 12582912 bytes, its byteLength says \
+         1000000000",
+    );
+}
+
+#[test]
+fn glb_chunks_longer_than_the_file_name_the_byte() {
+    let (doc, bin) = triangle_gltf();
+    let file = glb(&doc, &bin);
+    let json_len = u32::from_le_bytes([file[12], file[13], file[14], file[15]]) as usize;
+    let bin_chunk = 20 + json_len;
+    let mut long_chunk = file.clone();
+    long_chunk[bin_chunk..bin_chunk + 4].copy_from_slice(&0x7fff_ff00u32.to_le_bytes());
+    assert_refused(
+        "long_chunk.glb",
+        &long_chunk,
+        &format!(
+            "byte {}: unexpected end of file in the chunk at byte {bin_chunk}, which \
+             declares 2147483392 bytes",
+            file.len()
+        ),
+    );
+    let mut long_file = file.clone();
+    long_file[8..12].copy_from_slice(&u32::MAX.to_le_bytes());
+    assert_refused(
+        "long_header.glb",
+        &long_file,
+        &format!(
+            "byte {0}: unexpected end of file after {0} of the 4294967295 bytes the GLB \
+             header declares",
+            file.len()
+        ),
+    );
+}
+
+#[test]
+fn gltf_non_finite_attributes_and_bad_indices_name_the_accessor_or_primitive() {
+    let (doc, bin) = triangle_gltf();
+    let with = |at: usize, value: f32| {
+        let mut b = bin.clone();
+        b[at..at + 4].copy_from_slice(&value.to_le_bytes());
+        glb(&doc, &b)
+    };
+    // The second corner's v.
+    assert_refused(
+        "nan_uv.glb",
+        &with(36 + 12, f32::NAN),
+        "accessor 1 (TEXCOORD_0 of mesh 0 primitive 0): element 1 holds NaN, not a finite \
+         number",
+    );
+    assert_refused(
+        "inf_normal.glb",
+        &with(60 + 24 + 4, f32::INFINITY),
+        "accessor 2 (NORMAL of mesh 0 primitive 0): element 2 holds inf, not a finite number",
+    );
+    assert_refused(
+        "nan_position.glb",
+        &with(12, f32::NAN),
+        "accessor 0 (POSITION of mesh 0 primitive 0): element 1 holds NaN, not a finite \
+         number",
+    );
+    let mut b = bin.clone();
+    b[104..108].copy_from_slice(&9u32.to_le_bytes());
+    assert_refused(
+        "index_out_of_range.glb",
+        &glb(&doc, &b),
+        "mesh 0 primitive 0: index 9, but POSITION has 3 elements",
+    );
+}
+
+/// The texture coordinates of a `.gltf` read from disk come from the buffer file beside
+/// it: the hostile cases above differ from this one only where they say.
+#[test]
+fn the_unaltered_triangle_reads() {
+    let (mut doc, bin) = triangle_gltf();
+    doc["buffers"][0]["uri"] = json!("tri.bin");
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("a temporary directory: {e}"));
+    let path = dir.path().join("tri.gltf");
+    std::fs::write(&path, text(&doc)).unwrap_or_else(|e| panic!("written: {e}"));
+    std::fs::write(dir.path().join("tri.bin"), &bin).unwrap_or_else(|e| panic!("written: {e}"));
+    let mesh = read_path(Path::new(&path))
+        .unwrap_or_else(|e| panic!("the triangle reads: {e}"))
+        .mesh;
+    let uv = mesh.attributes.channel(ChannelKind::TexCoord);
+    assert_eq!(uv.and_then(|c| c.at_corner(0, 1)), Some(&[1.0, 0.0][..]));
 }
