@@ -171,3 +171,43 @@ fn stl_output_refuses_coordinates_beyond_float32() {
     let mut bytes = Vec::new();
     qem_mesh::io::write_to(&mut bytes, &edge, qem_mesh::io::Format::Stl).expect("fits");
 }
+
+/// A read_gltf reproducer (`fuzz/regressions/read_gltf/NAME`), read as glTF, and the same
+/// mesh after a trip through GLB.
+fn gltf_round_trip(name: &str) -> (IndexedMesh, IndexedMesh) {
+    use qem_mesh::io::{read_bytes, write_to, Format};
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../fuzz/regressions/read_gltf")
+        .join(name);
+    let data = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let read = |bytes: &[u8], format| {
+        read_bytes(bytes, format)
+            .unwrap_or_else(|e| panic!("{name}: refused: {e}"))
+            .mesh
+    };
+    let first = read(&data, Format::Gltf);
+    let mut glb = Vec::new();
+    write_to(&mut glb, &first, Format::Glb).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let again = read(&glb, Format::Glb);
+    (first, again)
+}
+
+/// The channels' names, in order.
+fn channel_names(mesh: &IndexedMesh) -> Vec<&str> {
+    let channels = &mesh.attributes.channels;
+    channels.iter().map(|c| c.name.as_str()).collect()
+}
+
+/// read_gltf finding 11 (`lone_texcoord_1*`): a primitive with `TEXCOORD_1` and no
+/// `TEXCOORD_0` (which the specification forbids, but files have) gave a channel `uv1`;
+/// the writer numbers sets from 0, as it must, so it came back as `uv`. Sets are now
+/// named by their rank among the file's sets of their kind.
+#[test]
+fn a_lone_texcoord_1_is_named_uv_and_keeps_its_name_through_glb() {
+    let (first, again) = gltf_round_trip("lone_texcoord_1_gltf");
+    assert_eq!(channel_names(&first), ["uv"]);
+    assert_eq!(channel_names(&again), ["uv"]);
+    let uv = |m: &IndexedMesh| m.attributes.channels[0].at_corner(0, 1).map(<[f32]>::to_vec);
+    assert_eq!(uv(&first), Some(vec![1.0, 1.0]), "v is flipped on reading");
+    assert_eq!(uv(&again), uv(&first));
+}

@@ -17,7 +17,9 @@
 //!   counted in [`ReadNotes::skipped_primitives`].
 //! - **Attributes.** `TEXCOORD_0` becomes the texture coordinate channel `uv`,
 //!   `NORMAL` the normal channel, `COLOR_0` (vec3 or vec4) the colour channel; further
-//!   sets become `uv1`, `colour1`...; application-specific attributes `_NAME` (scalar
+//!   sets become `uv1`, `colour1`... in the order of their numbers (a file that skips
+//!   a number, which the specification forbids, has its sets named as if it did not,
+//!   as the writer numbers them); application-specific attributes `_NAME` (scalar
 //!   to vec4) become generic channels named `NAME`. Any component type is read, with
 //!   `normalized` integers mapped to 0–1 or −1–1. `TANGENT`, `JOINTS_n` and
 //!   `WEIGHTS_n` are skipped and counted in [`ReadNotes::skipped_properties`] (tangents
@@ -664,11 +666,18 @@ impl Key {
         }
     }
 
-    /// The channel's name, before making it unique.
-    fn name(&self) -> String {
+    /// The channel's name, before making it unique, for the set that is number `rank`
+    /// among the file's sets of its kind (`TEXCOORD_1` alone is rank 0).
+    ///
+    /// Sets are named by rank rather than by their glTF number because the writer
+    /// numbers them from 0 without gaps, as the specification requires: naming
+    /// `TEXCOORD_1` alone `uv1` would make it `uv` after a round trip.
+    fn name(&self, rank: usize) -> String {
         match self {
-            Key::TexCoord(0) | Key::Normal | Key::Color(0) => self.kind().as_str().to_string(),
-            Key::TexCoord(n) | Key::Color(n) => format!("{}{n}", self.kind().as_str()),
+            Key::TexCoord(_) | Key::Color(_) if rank > 0 => {
+                format!("{}{rank}", self.kind().as_str())
+            }
+            Key::TexCoord(_) | Key::Normal | Key::Color(_) => self.kind().as_str().to_string(),
             Key::Custom(name) => name.clone(),
         }
     }
@@ -1140,10 +1149,13 @@ fn assemble(blocks: Vec<Block>, runs: Vec<Run>, materials: Labels, groups: Label
         positions.extend_from_slice(&b.positions);
     }
     let mut names: Vec<String> = Vec::new();
-    let mut channels = Vec::new();
+    let mut channels: Vec<Channel> = Vec::new();
     for (key, dim) in dims {
+        // The keys come sorted, so a set's rank is the number of channels of its kind
+        // before it.
+        let rank = channels.iter().filter(|c| c.kind == key.kind()).count();
         // Unique names: a `_NAME` attribute may be called like a standard channel.
-        let base = key.name();
+        let base = key.name(rank);
         let mut name = base.clone();
         let mut k = 1;
         while names.contains(&name) {
