@@ -211,3 +211,14 @@ fn a_lone_texcoord_1_is_named_uv_and_keeps_its_name_through_glb() {
     assert_eq!(uv(&first), Some(vec![1.0, 1.0]), "v is flipped on reading");
     assert_eq!(uv(&again), uv(&first));
 }
+
+/// read_gltf finding 12 (`negative_zero_in_float32*`): a node scale of 1e-30 puts a
+/// vertex at x = -1e-50, which float32 holds as -0.0; reading the written file back
+/// ran it through the identity transform, whose additions give +0.0, so the position's
+/// bits changed. Untransformed positions are now taken as they are.
+#[test]
+fn a_position_that_float32_rounds_to_negative_zero_keeps_its_sign() {
+    let (first, again) = gltf_round_trip("negative_zero_in_float32_gltf");
+    assert!(first.positions[0][0] < 0.0 && first.positions[0][0] > -1e-49);
+    assert_eq!(again.positions[0][0].to_bits(), (-0.0f64).to_bits());
+}

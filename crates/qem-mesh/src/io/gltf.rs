@@ -1052,10 +1052,16 @@ fn read_positions(
         return Err(malformed(format!("{what}: POSITION must be VEC3")));
     }
     let mut positions = Vec::with_capacity(pos.count);
+    // Untransformed positions are kept as they are: the identity's arithmetic turns
+    // -0.0 into 0.0, and a round trip through glTF would then not be bit for bit.
+    let identity = placed.world == DMat4::IDENTITY;
     for (v, c) in pos.finite_floats()?.chunks_exact(3).enumerate() {
-        let p = placed
-            .world
-            .transform_point3(DVec3::new(c[0].into(), c[1].into(), c[2].into()));
+        let c = DVec3::new(c[0].into(), c[1].into(), c[2].into());
+        let p = if identity {
+            c
+        } else {
+            placed.world.transform_point3(c)
+        };
         if !p.is_finite() {
             return Err(malformed(format!(
                 "{what}: vertex {v} is not finite after its node's transform"
