@@ -222,3 +222,19 @@ fn a_position_that_float32_rounds_to_negative_zero_keeps_its_sign() {
     assert!(first.positions[0][0] < 0.0 && first.positions[0][0] > -1e-49);
     assert_eq!(again.positions[0][0].to_bits(), (-0.0f64).to_bits());
 }
+
+/// read_gltf finding 13 (`one_material_with_and_without_uv*`): two primitives of one
+/// material (here none), one with `TEXCOORD_0` and one without, were written as one
+/// primitive with `TEXCOORD_0`, so the second's faces came back with the zeros the
+/// shared accessor holds for them. The writer now gives faces with and without a
+/// channel primitives of their own.
+#[test]
+fn faces_of_one_material_without_a_channel_come_back_without_it() {
+    let (first, again) = gltf_round_trip("one_material_with_and_without_uv_gltf");
+    for mesh in [&first, &again] {
+        assert_eq!(mesh.triangle_count(), 2);
+        let uv = &mesh.attributes.channels[0];
+        assert!(uv.at_corner(0, 0).is_some(), "the first primitive has uvs");
+        assert_eq!(uv.at_corner(1, 0), None, "the fan has none");
+    }
+}

@@ -59,8 +59,10 @@
 //! an `InvalidInput` error); the first normal channel as `NORMAL`, texture coordinate
 //! channels as `TEXCOORD_0`, `TEXCOORD_1`..., colours as `COLOR_0`... (`float32`), and
 //! generic channels as `_NAME`; one glTF mesh per group (named after it) and within
-//! it one primitive per material, with `u32` indices; every vertex accessor is shared
-//! by all primitives. The materials are written as glTF materials carrying only their
+//! it one primitive per material and set of channels present (faces without a value
+//! in a channel get a primitive without that attribute, so they read back without
+//! one), with `u32` indices; every vertex accessor is shared by all primitives. A
+//! face with a value at some corners only has zeros at the others. The materials are written as glTF materials carrying only their
 //! names. Names that are not UTF-8 are written with U+FFFD in place of invalid bytes.
 //!
 //! # What is not carried through
@@ -1301,8 +1303,9 @@ fn invalid(message: String) -> io::Error {
     io::Error::new(io::ErrorKind::InvalidInput, message)
 }
 
-/// A primitive to write: its material label and its faces.
-type Primitive = (u32, Vec<usize>);
+/// A primitive to write: its material label, which written channels it has, and its
+/// faces.
+type Primitive = (u32, Vec<bool>, Vec<usize>);
 
 /// Writes `mesh` as glTF JSON with an embedded buffer, or as GLB.
 pub(crate) fn write<W: Write>(out: &mut W, mesh: &IndexedMesh, format: Format) -> io::Result<()> {
@@ -1366,30 +1369,38 @@ pub(crate) fn write<W: Write>(out: &mut W, mesh: &IndexedMesh, format: Format) -
             let a = b.add(floats(values), count, kind, FLOAT, ARRAY_BUFFER, None);
             attributes.push((semantic, a));
         }
-        // Faces by group (one glTF mesh each) and within a group by material (one
-        // primitive each), both in order of first appearance.
+        // Faces by group (one glTF mesh each) and within a group by material and by
+        // the channels they have (one primitive each), all in order of first
+        // appearance. A glTF attribute belongs to a whole primitive: faces with a
+        // channel and faces without it (two primitives of one material in the file
+        // read) need primitives of their own, or the second would read back with the
+        // zeros the shared accessor holds for them rather than with no value.
         let label = |l: &FaceLabels, t: usize| l.faces.get(t).copied().unwrap_or(FaceLabels::NONE);
         let (materials, groups) = (&mesh.attributes.materials, &mesh.attributes.groups);
         let mut meshes: Vec<(u32, Vec<Primitive>)> = Vec::new();
         let mut mesh_of: HashMap<u32, usize> = HashMap::new();
-        let mut primitive_of: HashMap<(u32, u32), usize> = HashMap::new();
+        let mut primitive_of: HashMap<(u32, u32, Vec<bool>), usize> = HashMap::new();
         for t in 0..pv.triangles.len() {
             let (g, m) = (label(groups, t), label(materials, t));
+            let has: Vec<bool> = written
+                .iter()
+                .map(|c| c.corners[t].iter().any(|&i| i != Channel::MISSING))
+                .collect();
             let gi = *mesh_of.entry(g).or_insert_with(|| {
                 meshes.push((g, Vec::new()));
                 meshes.len() - 1
             });
             let prims = &mut meshes[gi].1;
-            let pi = *primitive_of.entry((g, m)).or_insert_with(|| {
-                prims.push((m, Vec::new()));
+            let pi = *primitive_of.entry((g, m, has.clone())).or_insert_with(|| {
+                prims.push((m, has, Vec::new()));
                 prims.len() - 1
             });
-            prims[pi].1.push(t);
+            prims[pi].2.push(t);
         }
         let mut json_meshes = Vec::new();
         for (g, prims) in &meshes {
             let mut primitives = Vec::new();
-            for (m, faces) in prims {
+            for (m, has, faces) in prims {
                 let indices = faces
                     .iter()
                     .flat_map(|&t| pv.triangles[t])
@@ -1408,11 +1419,8 @@ pub(crate) fn write<W: Write>(out: &mut W, mesh: &IndexedMesh, format: Format) -
                 // reading gives those corners no value again (rather than zeros).
                 let mut used = serde_json::Map::new();
                 used.insert("POSITION".into(), position.into());
-                for ((semantic, a), c) in attributes.iter().zip(&written) {
-                    let has = |t: &usize| c.corners[*t].iter().any(|&i| i != Channel::MISSING);
-                    if faces.iter().any(has) {
-                        used.insert(semantic.to_string(), (*a).into());
-                    }
+                for ((semantic, a), _) in attributes.iter().zip(has).filter(|(_, &h)| h) {
+                    used.insert(semantic.to_string(), (*a).into());
                 }
                 let mut p = serde_json::json!({
                     "attributes": used,
