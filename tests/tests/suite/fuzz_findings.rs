@@ -238,3 +238,16 @@ fn faces_of_one_material_without_a_channel_come_back_without_it() {
         assert_eq!(uv.at_corner(1, 0), None, "the fan has none");
     }
 }
+
+/// read_gltf finding 14 (`texcoord_of_a_primitive_without_triangles*`): a strip of
+/// two vertices (no triangle) with `TEXCOORD_0` gave a channel `uv` that no corner
+/// has, and the triangle's `TEXCOORD_1` the channel `uv1`; the writer wrote `uv1` as
+/// `TEXCOORD_1` beside an unused `TEXCOORD_0`, which read back as `uv`. Only attributes
+/// some triangle uses now make channels.
+#[test]
+fn an_attribute_only_a_primitive_without_triangles_has_makes_no_channel() {
+    let (first, again) = gltf_round_trip("texcoord_of_a_primitive_without_triangles_gltf");
+    assert_eq!(first.triangle_count(), 1);
+    assert_eq!(channel_names(&first), ["uv"]);
+    assert_eq!(channel_names(&again), ["uv"]);
+}

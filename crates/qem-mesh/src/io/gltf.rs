@@ -74,7 +74,7 @@
 //! names but default (white, PBR metallic-roughness) materials without textures.
 //! Keeping them would need the source document inside the mesh; that is not done.
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::{BTreeMap, HashMap, HashSet};
 use std::io::{self, Write};
 
 use glam::{DMat3, DMat4, DQuat, DVec3};
@@ -1143,9 +1143,18 @@ fn flip_v(v: f32) -> f32 {
 /// One mesh from the blocks and runs: positions and triangles concatenated, a
 /// channel per attribute key any block has (missing where a block lacks it).
 fn assemble(blocks: Vec<Block>, runs: Vec<Run>, materials: Labels, groups: Labels) -> IndexedMesh {
+    // Only attributes some triangle uses make channels, with the dimension of those
+    // uses: a primitive without triangles (a strip of two indices) would otherwise
+    // give a channel no corner has, which the writer cannot write back as such (it
+    // would shift the numbering of the sets that are used, or widen vec3 colours).
+    let used: HashSet<(usize, &Key)> = runs
+        .iter()
+        .filter(|r| !r.triangles.is_empty())
+        .flat_map(|r| r.keys.iter().map(|k| (r.block, k)))
+        .collect();
     let mut dims: BTreeMap<Key, usize> = BTreeMap::new();
-    for block in &blocks {
-        for (key, v) in &block.values {
+    for &(b, key) in &used {
+        if let Some(v) = blocks[b].values.get(key) {
             let e = dims.entry(key.clone()).or_insert(v.dimension);
             *e = (*e).max(v.dimension);
         }
@@ -1173,8 +1182,8 @@ fn assemble(blocks: Vec<Block>, runs: Vec<Run>, materials: Labels, groups: Label
         names.push(name.clone());
         let mut values = Vec::new();
         let mut base = Vec::with_capacity(blocks.len());
-        for b in &blocks {
-            match b.values.get(&key) {
+        for (bi, b) in blocks.iter().enumerate() {
+            match b.values.get(&key).filter(|_| used.contains(&(bi, &key))) {
                 Some(v) => {
                     base.push(Some((values.len() / dim) as u32));
                     let d = v.dimension;
