@@ -130,10 +130,13 @@ struct Face {
     positions: [[u64; 3]; 3],
     material: Option<Vec<u8>>,
     group: Option<Vec<u8>>,
-    /// Name, kind and the value bits at each corner (`None` where a corner has none),
-    /// sorted by name (names are unique within a mesh).
-    channels: Vec<(String, ChannelKind, [Option<Vec<u32>>; 3])>,
+    /// Sorted by name (names are unique within a mesh).
+    channels: Vec<CornerValues>,
 }
+
+/// A channel at one triangle: its name, its kind and the bits of its value at each
+/// corner (`None` where a corner has none).
+type CornerValues = (String, ChannelKind, [Option<Vec<u32>>; 3]);
 
 /// Every triangle of `mesh` as a [`Face`], in order, positions through `bits`.
 fn faces(mesh: &IndexedMesh, bits: impl Fn(f64) -> u64) -> Vec<Face> {

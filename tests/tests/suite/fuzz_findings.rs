@@ -207,7 +207,11 @@ fn a_lone_texcoord_1_is_named_uv_and_keeps_its_name_through_glb() {
     let (first, again) = gltf_round_trip("lone_texcoord_1_gltf");
     assert_eq!(channel_names(&first), ["uv"]);
     assert_eq!(channel_names(&again), ["uv"]);
-    let uv = |m: &IndexedMesh| m.attributes.channels[0].at_corner(0, 1).map(<[f32]>::to_vec);
+    let uv = |m: &IndexedMesh| {
+        m.attributes.channels[0]
+            .at_corner(0, 1)
+            .map(<[f32]>::to_vec)
+    };
     assert_eq!(uv(&first), Some(vec![1.0, 1.0]), "v is flipped on reading");
     assert_eq!(uv(&again), uv(&first));
 }

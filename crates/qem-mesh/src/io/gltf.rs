@@ -1516,7 +1516,9 @@ mod tests {
         assert_eq!(encode_base64(b"Man"), "TWFu");
         assert_eq!(decode_base64(b"TWE"), Some(b"Ma".to_vec()));
         assert_eq!(decode_base64(b"TW!u"), None);
-        for text in ["", "T", "TW", "TWE", "TWFu", "TWFuTQ", "TWFuTQ==", "TWFuTWE="] {
+        for text in [
+            "", "T", "TW", "TWE", "TWFu", "TWFuTQ", "TWFuTQ==", "TWFuTWE=",
+        ] {
             let decoded = decode_base64(text.as_bytes()).unwrap();
             assert_eq!(decoded_len(text.as_bytes()), decoded.len(), "{text}");
         }

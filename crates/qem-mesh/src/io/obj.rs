@@ -373,7 +373,9 @@ fn prescan(bytes: &[u8], detailed: bool) -> Result<Scan, ReadError> {
             b"vt" => {
                 let index = so_far.vt;
                 numbers(2, "texture coordinate", index)?;
-                check_f32(words(rest).take(2), at, || format!("texture coordinate {index}"))?;
+                check_f32(words(rest).take(2), at, || {
+                    format!("texture coordinate {index}")
+                })?;
                 so_far.vt += 1;
             }
             b"vn" => {

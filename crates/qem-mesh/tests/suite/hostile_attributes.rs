@@ -169,7 +169,8 @@ fn triangle_gltf() -> (Value, Vec<u8>) {
     );
     mesh.attributes.channels = vec![uv, normal];
     let file = encode(&mesh, Format::Glb);
-    let u32_at = |at: usize| u32::from_le_bytes([file[at], file[at + 1], file[at + 2], file[at + 3]]);
+    let u32_at =
+        |at: usize| u32::from_le_bytes([file[at], file[at + 1], file[at + 2], file[at + 3]]);
     let json_len = u32_at(12) as usize;
     let doc = serde_json::from_slice(&file[20..20 + json_len])
         .unwrap_or_else(|e| panic!("the writer's JSON: {e}"));
