@@ -255,3 +255,62 @@ fn an_attribute_only_a_primitive_without_triangles_has_makes_no_channel() {
     assert_eq!(channel_names(&first), ["uv"]);
     assert_eq!(channel_names(&again), ["uv"]);
 }
+
+/// The colours of `name`'s first vertex (a `fuzz/regressions/TARGET` reproducer), read
+/// in `format`, and after a trip through the same format.
+fn first_colour_round_trip(
+    target: &str,
+    name: &str,
+    format: qem_mesh::io::Format,
+) -> (Vec<f32>, Vec<f32>) {
+    use qem_mesh::attributes::ChannelKind;
+    use qem_mesh::io::{read_bytes, write_to};
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../fuzz/regressions")
+        .join(target)
+        .join(name);
+    let data = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let read = |bytes: &[u8]| {
+        read_bytes(bytes, format)
+            .unwrap_or_else(|e| panic!("{name}: refused: {e}"))
+            .mesh
+    };
+    let colour = |mesh: &IndexedMesh| -> Vec<f32> {
+        let channel = mesh.attributes.channel(ChannelKind::Color);
+        channel
+            .and_then(|c| c.at_corner(0, 0))
+            .unwrap_or_default()
+            .to_vec()
+    };
+    let first = read(&data);
+    let mut written = Vec::new();
+    write_to(&mut written, &first, format).unwrap_or_else(|e| panic!("{name}: {e}"));
+    (colour(&first), colour(&read(&written)))
+}
+
+/// read_obj finding 15 (`colour_level_above_255`, found by the attribute round trip
+/// on a hand-made file before the run): `v 0 0 0 300 0 0` makes the file's colours
+/// 0–255 levels, and 300/255 ≈ 1.18 was kept; written back, that value above 1 made
+/// the levels rule divide every colour by 255 again. Colours are now clamped to 0–1
+/// after the rule, in OBJ and OFF.
+#[test]
+fn an_obj_colour_level_above_255_is_clamped_and_survives_a_round_trip() {
+    let (first, again) = first_colour_round_trip(
+        "read_obj",
+        "colour_level_above_255",
+        qem_mesh::io::Format::Obj,
+    );
+    assert_eq!(first, [1.0, 0.0, 0.0]);
+    assert_eq!(again, first);
+}
+
+/// read_off finding 16 (`negative_colour`, found like finding 15): a COFF colour of
+/// −1 was kept (no component above 1, so not levels), and the writer, which clamps
+/// colours to 0–1, wrote 0. The reader now clamps too.
+#[test]
+fn a_negative_off_colour_is_clamped_and_survives_a_round_trip() {
+    let (first, again) =
+        first_colour_round_trip("read_off", "negative_colour", qem_mesh::io::Format::Off);
+    assert_eq!(first, [0.0, 0.0, 0.0]);
+    assert_eq!(again, first);
+}

@@ -61,6 +61,24 @@ pub(crate) fn from_level(level: f64, max: f64) -> f32 {
     (level / max) as f32
 }
 
+/// A file's colours in 0–1, for the formats that do not say whether they hold 0–1
+/// floats or 0–255 levels (OBJ's `v x y z r g b`, OFF): levels when any component is
+/// above 1, since 0–1 colours never are, and floats otherwise; a file's colours either
+/// all are levels or none is, so one dark colour cannot be read differently from the
+/// others. Then every component is clamped to 0–1: one still outside (a level above
+/// 255, a negative value) could not be written back in these formats, where a value
+/// above 1 makes every colour of the file a level when it is read again.
+pub(crate) fn unit_colours(colours: &mut [f32]) {
+    let levels = colours.iter().any(|&c| c > 1.0);
+    for c in colours {
+        if levels {
+            *c = from_level(f64::from(*c), 255.0);
+        }
+        // NaN stays NaN, for the reader's check to name.
+        *c = c.clamp(0.0, 1.0);
+    }
+}
+
 /// The `uchar` level of a colour component: `round(v * 255)`, clamped to 0–255.
 pub(crate) fn to_level(v: f32) -> u8 {
     // The cast saturates (NaN gives 0), so out-of-range values are clamped.
@@ -91,5 +109,18 @@ mod tests {
         assert!(!all_levels(&[-0.0]));
         assert_eq!(to_level(2.0), 255);
         assert_eq!(to_level(-1.0), 0);
+    }
+
+    #[test]
+    fn colours_are_levels_when_one_is_above_1_and_end_in_0_to_1() {
+        let mut floats = [0.5, -0.25, 1.0];
+        unit_colours(&mut floats);
+        assert_eq!(floats, [0.5, 0.0, 1.0]);
+        let mut levels = [255.0, 300.0, -3.0, 51.0];
+        unit_colours(&mut levels);
+        assert_eq!(levels, [1.0, 1.0, 0.0, from_level(51.0, 255.0)]);
+        let mut nan = [f32::NAN];
+        unit_colours(&mut nan);
+        assert!(nan[0].is_nan());
     }
 }

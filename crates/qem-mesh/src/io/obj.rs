@@ -5,7 +5,9 @@
 //! ([`crate::attributes`]): texture coordinates (`vt`) and normals (`vn`) per corner,
 //! each face's group (`o`/`g`) and material (`usemtl`), and the material files
 //! (`mtllib`, not opened), and vertex colours (`v x y z r g b`, read as 0–1; a file
-//! with a value above 1 is read as 0–255 levels). A corner without a `vt` or `vn` index has none
+//! with a value above 1 is read as 0–255 levels; a component still outside 0–1 is
+//! clamped, since no OBJ file could hold it: written back, a value above 1 would make
+//! every colour a level). A corner without a `vt` or `vn` index has none
 //! ([`Channel::MISSING`]): `tobj` would fill it with a neighbour's value, so the reader
 //! marks those corners from its own scan. `l` and `p` elements, points and lines
 //! written as `f` with one or two corners, and smoothing groups are ignored. Polygons
@@ -748,9 +750,7 @@ fn assemble(models: &[tobj::Model]) -> IndexedMesh {
     }
     if colours {
         // Some exporters write 0–255 levels: a value above 1 says so.
-        if colour.iter().any(|&c| c > 1.0) {
-            colour.iter_mut().for_each(|c| *c /= 255.0);
-        }
+        super::channels::unit_colours(&mut colour);
         let corners = mesh.triangles.clone();
         mesh.attributes
             .channels
