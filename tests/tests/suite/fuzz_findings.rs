@@ -314,3 +314,28 @@ fn a_negative_off_colour_is_clamped_and_survives_a_round_trip() {
     assert_eq!(first, [0.0, 0.0, 0.0]);
     assert_eq!(again, first);
 }
+
+/// read_obj finding 17 (`mixed_face_after_*`): a face where some corners have a `vn`
+/// (or `vt`) and others not, after faces where none has, lost the values of the
+/// corners that have one: the run of faces without normals ran on over it, and only
+/// a mixed face's missing corners were meant to be marked. Found by the attribute
+/// round trip, where the writer's own `f 4 4//2 5//2` lost them on reading back; the
+/// first reading of such a file lost them as well.
+#[test]
+fn a_mixed_face_after_faces_without_normals_keeps_its_normals() {
+    use qem_mesh::attributes::ChannelKind;
+    use qem_mesh::io::{read_bytes, Format};
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../fuzz/regressions/read_obj/mixed_face_after_a_face_without_vn");
+    let data = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mesh = read_bytes(&data, Format::Obj)
+        .unwrap_or_else(|e| panic!("refused: {e}"))
+        .mesh;
+    let normal = mesh
+        .attributes
+        .channel(ChannelKind::Normal)
+        .unwrap_or_else(|| panic!("no normals"));
+    let has = |t: usize| [0, 1, 2].map(|k| normal.at_corner(t, k).is_some());
+    assert_eq!(has(0), [false; 3]);
+    assert_eq!(has(1), [false, true, true]);
+}

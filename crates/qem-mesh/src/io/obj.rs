@@ -164,6 +164,13 @@ impl Slots {
             }
             return;
         }
+        // A mixed face lies in a run where every corner has both, and only its own
+        // corners without one are marked. The run must start at this face: the run
+        // before it (say, faces without `vn`) would otherwise cover it and mark its
+        // corners that have one as missing too.
+        if self.runs.last().is_none_or(|r| (r.1, r.2) != (true, true)) {
+            self.runs.push((first, true, true));
+        }
         // Fan triangulation: triangle j of the face has corners 0, j + 1, j + 2.
         let corners: Vec<(bool, bool)> = words(rest).map(corner_slots).collect();
         for j in 0..corners.len().saturating_sub(2) {
@@ -171,9 +178,6 @@ impl Slots {
                 self.mixed.push((first + j, k, corners[c].0, corners[c].1));
             }
         }
-        // The run after a mixed face starts fresh.
-        self.runs
-            .push((first + corners.len().saturating_sub(2), true, true));
     }
 
     /// Marks the corners without an index as missing in `uv` and `normal`.
