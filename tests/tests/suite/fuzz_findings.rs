@@ -339,3 +339,21 @@ fn a_mixed_face_after_faces_without_normals_keeps_its_normals() {
     assert_eq!(has(0), [false; 3]);
     assert_eq!(has(1), [false, true, true]);
 }
+
+/// read_ply finding 18 (`control_byte*_in_property_name*`, `vector_without_a_name`):
+/// the reader made generic channels of properties whose names no PLY file can hold (a
+/// fuzzed header had `diff&use\0\x0b_red`; `_0 _1` made a vector named ""), which the
+/// writer then left out, so a round trip lost them. The reader now skips them too.
+#[test]
+fn ply_properties_the_writer_cannot_name_are_skipped() {
+    use qem_mesh::io::{read_bytes, Format};
+    for name in ["control_byte_in_property_name", "vector_without_a_name"] {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../fuzz/regressions/read_ply")
+            .join(name);
+        let data = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let loaded = read_bytes(&data, Format::Ply).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert!(loaded.mesh.attributes.channels.is_empty(), "{name}");
+        assert!(loaded.notes.skipped_properties > 0, "{name}");
+    }
+}

@@ -16,7 +16,8 @@
 //! - texture coordinates `s t`, `u v`, `texture_u texture_v` or `texture_s texture_t`;
 //! - every other scalar: a [`ChannelKind::Generic`] channel named after the property,
 //!   and `<name>_0`, `<name>_1`... (2 to 4 in a row) as one vector channel `<name>`.
-//!   Integers become floats (exact up to 2^24).
+//!   Integers become floats (exact up to 2^24). A name that no PLY file could hold
+//!   (empty, or with a space or control byte) is skipped, as the writer leaves it out.
 //!
 //! Only the first complete set of each kind is read; a property named like a member of
 //! a set (`red`, `u`, ...) outside a complete set is skipped. The face element's
@@ -302,6 +303,14 @@ fn is_reserved(name: &[u8]) -> bool {
     matches!(name, b"x" | b"y" | b"z") || VERTEX_SETS.iter().any(|(_, set)| set.contains(&name))
 }
 
+/// Whether a generic channel's name can be a PLY property name: not empty, and without
+/// spaces or control bytes (which PLY readers take for a separator or choke on). The
+/// writer leaves other channels out; the reader skips such properties (a fuzzed
+/// header had `diff&use\0\x0b_red`), so that what it reads it can write back.
+fn is_writable_name(name: &[u8]) -> bool {
+    !name.is_empty() && !name.iter().any(|&b| b <= b' ' || b == 0x7f)
+}
+
 /// How a property's number becomes a channel's float.
 #[derive(Clone, Copy, Debug)]
 enum Convert {
@@ -460,7 +469,12 @@ fn plan(el: &Element, side: Side, names: &mut Vec<String>) -> Result<Plan, ReadE
         // Every other scalar: a generic channel; `<base>_0`, `<base>_1`... (2 to 4 in a
         // row) together, as the writer writes a generic vector.
         let free = |i: usize| {
-            scalar(i) && !member[i] && !is_reserved(el.props[i].0) && matches!(roles[i], Role::Skip)
+            let name = el.props[i].0;
+            scalar(i)
+                && !member[i]
+                && !is_reserved(name)
+                && is_writable_name(name)
+                && matches!(roles[i], Role::Skip)
         };
         let mut i = 0;
         while i < el.props.len() {
@@ -484,6 +498,11 @@ fn plan(el: &Element, side: Side, names: &mut Vec<String>) -> Result<Plan, ReadE
             } else {
                 name
             };
+            // `_0`, `_1`: a vector without a name.
+            if !is_writable_name(shown) {
+                i += len;
+                continue;
+            }
             candidates.push((
                 ChannelKind::Generic,
                 String::from_utf8_lossy(shown).into_owned(),
@@ -1161,7 +1180,7 @@ pub(crate) fn placements(channels: &[Channel]) -> Vec<Placement> {
                             .map(|k| format!("{}_{k}", c.name))
                             .collect()
                     };
-                    if c.name.is_empty() || c.name.bytes().any(|b| b <= b' ' || b == 0x7f) {
+                    if !is_writable_name(c.name.as_bytes()) {
                         Placement::Left("a PLY property name cannot be empty or hold spaces")
                     } else if names.iter().any(|n| is_reserved(n.as_bytes())) {
                         Placement::Left("PLY readers give this property name another meaning")
