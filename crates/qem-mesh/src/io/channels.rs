@@ -65,17 +65,20 @@ pub(crate) fn from_level(level: f64, max: f64) -> f32 {
 /// floats or 0–255 levels (OBJ's `v x y z r g b`, OFF): levels when any component is
 /// above 1, since 0–1 colours never are, and floats otherwise; a file's colours either
 /// all are levels or none is, so one dark colour cannot be read differently from the
-/// others. Then every component is clamped to 0–1: one still outside (a level above
-/// 255, a negative value) could not be written back in these formats, where a value
-/// above 1 makes every colour of the file a level when it is read again.
+/// others. Then every finite component is clamped to 0–1: one still outside (a level
+/// above 255, a negative value) could not be written back in these formats, where a
+/// value above 1 makes every colour of the file a level when it is read again. NaN and
+/// infinities (`1e39` is one in `f32`) are left for the reader to refuse, with the
+/// line, as it refuses them in coordinates.
 pub(crate) fn unit_colours(colours: &mut [f32]) {
     let levels = colours.iter().any(|&c| c > 1.0);
-    for c in colours {
+    for c in colours.iter_mut() {
         if levels {
             *c = from_level(f64::from(*c), 255.0);
         }
-        // NaN stays NaN, for the reader's check to name.
-        *c = c.clamp(0.0, 1.0);
+        if c.is_finite() {
+            *c = c.clamp(0.0, 1.0);
+        }
     }
 }
 
@@ -119,8 +122,9 @@ mod tests {
         let mut levels = [255.0, 300.0, -3.0, 51.0];
         unit_colours(&mut levels);
         assert_eq!(levels, [1.0, 1.0, 0.0, from_level(51.0, 255.0)]);
-        let mut nan = [f32::NAN];
-        unit_colours(&mut nan);
-        assert!(nan[0].is_nan());
+        let mut non_finite = [f32::NAN, f32::INFINITY, 0.5];
+        unit_colours(&mut non_finite);
+        assert!(non_finite[0].is_nan());
+        assert_eq!(non_finite[1..], [f32::INFINITY, from_level(0.5, 255.0)]);
     }
 }

@@ -68,6 +68,12 @@ fn obj_texture_coordinates_normals_and_colours_beyond_float32_name_their_line() 
         b"v 0 0 0 1 0 0\nv 1 0 0 0 NaN 0\nv 0 1 0 0 0 1\nf 1 2 3\n",
         "line 2: vertex 1: colour: \"NaN\" is not a finite 32-bit float",
     );
+    // Beyond float32 even as a 0–255 level: not clamped to 1, but refused.
+    assert_refused(
+        "huge_colour.obj",
+        b"v 0 0 0 255 0 0\nv 1 0 0 0 1e39 0\nv 0 1 0 0 0 255\nf 1 2 3\n",
+        "line 2: vertex 1: colour: \"1e39\" is not a finite 32-bit float",
+    );
 }
 
 #[test]
