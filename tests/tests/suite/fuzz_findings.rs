@@ -357,3 +357,29 @@ fn ply_properties_the_writer_cannot_name_are_skipped() {
         assert!(loaded.notes.skipped_properties > 0, "{name}");
     }
 }
+
+/// read_obj finding 19 (`names_ending_in_a_backslash`): a group, material or material
+/// library name that ends in a backslash (`g seg \` followed by a space, which the
+/// reader trims) was written as `g seg \` and a line break, which OBJ reads as a line
+/// continuation: the next line (a face, a vertex) became part of the name. The writer
+/// now puts a space after such a name.
+#[test]
+fn obj_names_ending_in_a_backslash_survive_a_round_trip() {
+    use qem_mesh::io::{read_bytes, write_to, Format};
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../fuzz/regressions/read_obj/names_ending_in_a_backslash");
+    let data = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let read = |bytes: &[u8]| {
+        read_bytes(bytes, Format::Obj)
+            .unwrap_or_else(|e| panic!("refused: {e}"))
+            .mesh
+    };
+    let first = read(&data);
+    let names = &first.attributes;
+    assert_eq!(names.groups.names, [b"seg \\".to_vec()]);
+    assert_eq!(names.materials.names, [b"red\\\\".to_vec()]);
+    assert_eq!(names.material_libraries, [b"lib\\".to_vec()]);
+    let mut written = Vec::new();
+    write_to(&mut written, &first, Format::Obj).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(read(&written), first);
+}

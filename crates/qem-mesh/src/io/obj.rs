@@ -17,7 +17,10 @@
 //! The writer writes all of it: `mtllib`, `v` (with its colour; a vertex with colour
 //! seams once per colour, which an exact weld joins again), `vt`, `vn`, then the faces as
 //! `v/vt/vn` corners with a `g` or `usemtl` line wherever the group or material
-//! changes (the first channel of each kind: OBJ has one slot each).
+//! changes (the first channel of each kind: OBJ has one slot each). Names are written
+//! byte for byte, except that a line feed becomes a space and a name ending in a
+//! backslash is followed by a space (which the reader trims), so that it does not
+//! continue its line.
 //!
 //! `tobj` splits the file into one model per `o`/`g`/`usemtl` section and numbers each
 //! model's vertices in the order its faces first use them. The reader concatenates the
@@ -773,6 +776,24 @@ fn push_corners(dst: &mut Vec<[u32; 3]>, src: &[u32], base: u32, ntri: usize) {
     }
 }
 
+/// Writes a name (group, material, material library) as the reader will read it back,
+/// byte for byte where OBJ can hold it: a line feed (a glTF name may have one) becomes
+/// a space, and a name that ends in a backslash (or a carriage return) gets a space
+/// after it, which the reader trims, since a backslash before the line break would
+/// continue the line (a fuzzed `g seg \\` took the next `f` line into the name).
+fn write_name(out: &mut impl Write, name: &[u8]) -> std::io::Result<()> {
+    for (k, line) in name.split(|&b| b == b'\n').enumerate() {
+        if k > 0 {
+            out.write_all(b" ")?;
+        }
+        out.write_all(line)?;
+    }
+    if name.ends_with(b"\\") || name.ends_with(b"\r") {
+        out.write_all(b" ")?;
+    }
+    Ok(())
+}
+
 pub(crate) fn write(
     out: &mut impl Write,
     mesh: &IndexedMesh,
@@ -810,7 +831,7 @@ pub(crate) fn write(
     )?;
     for library in &attrs.material_libraries {
         out.write_all(b"mtllib ")?;
-        out.write_all(library)?;
+        write_name(out, library)?;
         out.write_all(b"\n")?;
     }
     for (v, [x, y, z]) in positions.iter().enumerate() {
@@ -851,7 +872,7 @@ pub(crate) fn write(
                 out.write_all(keyword)?;
                 if let Some(name) = labels.names.get(label as usize) {
                     out.write_all(b" ")?;
-                    out.write_all(name)?;
+                    write_name(out, name)?;
                 }
                 out.write_all(b"\n")?;
             }
