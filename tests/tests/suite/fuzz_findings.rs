@@ -383,3 +383,24 @@ fn obj_names_ending_in_a_backslash_survive_a_round_trip() {
     write_to(&mut written, &first, Format::Obj).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(read(&written), first);
 }
+
+/// read_ply finding 20 (`property_names_*twice*`): `flow_0 flow_1` and a second
+/// `flow_0` (or two names that differ only in bytes that are not UTF-8) gave a vector
+/// channel `flow` and a scalar `flow_0`, which the writer would both write as `flow_0`;
+/// it leaves the second out, so a round trip lost it. The reader now skips a generic
+/// channel whose property names an earlier one has.
+#[test]
+fn a_ply_property_name_two_channels_would_write_is_read_once() {
+    use qem_mesh::io::{read_bytes, Format};
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../fuzz/regressions/read_ply/property_names_of_a_vector_twice");
+    let data = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let loaded = read_bytes(&data, Format::Ply).unwrap_or_else(|e| panic!("{e}"));
+    let channels = &loaded.mesh.attributes.channels;
+    let names: Vec<(&str, usize)> = channels
+        .iter()
+        .map(|c| (c.name.as_str(), c.dimension))
+        .collect();
+    assert_eq!(names, [("flow", 2)]);
+    assert_eq!(loaded.notes.skipped_properties, 1);
+}

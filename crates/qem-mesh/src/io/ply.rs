@@ -303,6 +303,17 @@ fn is_reserved(name: &[u8]) -> bool {
     matches!(name, b"x" | b"y" | b"z") || VERTEX_SETS.iter().any(|(_, set)| set.contains(&name))
 }
 
+/// The PLY property names of a generic channel: its name, or `<name>_0`, `<name>_1`...
+/// for a vector. The writer writes them; the reader skips a channel whose names an
+/// earlier one has, which the writer could not write.
+fn generic_property_names(name: &str, dimension: usize) -> Vec<String> {
+    if dimension == 1 {
+        vec![name.to_string()]
+    } else {
+        (0..dimension).map(|k| format!("{name}_{k}")).collect()
+    }
+}
+
 /// Whether a generic channel's name can be a PLY property name: not empty, and without
 /// spaces or control bytes (which PLY readers take for a separator or choke on). The
 /// writer leaves other channels out; the reader skips such properties (a fuzzed
@@ -514,9 +525,21 @@ fn plan(el: &Element, side: Side, names: &mut Vec<String>) -> Result<Plan, ReadE
 
     // Accepted in priority order (sets, then generics), kept in property order.
     let mut accepted = Vec::new();
+    // The property names of the generic channels accepted, as the writer names them.
+    let mut written: Vec<String> = Vec::new();
     for (kind, name, members) in candidates {
         if names.len() >= MAX_CHANNELS || names.contains(&name) {
             continue;
+        }
+        if kind == ChannelKind::Generic {
+            // A channel whose property names another has could not be written back
+            // (`a_0 a_1` and a second `a_0`; or two names that differ only in bytes
+            // that are not UTF-8, which both become U+FFFD), so it is skipped.
+            let props = generic_property_names(&name, members.len());
+            if props.iter().any(|p| written.contains(p)) {
+                continue;
+            }
+            written.extend(props);
         }
         names.push(name.clone());
         accepted.push((kind, name, members));
@@ -1173,13 +1196,7 @@ pub(crate) fn placements(channels: &[Channel]) -> Vec<Placement> {
                 ChannelKind::Color if on_face => Placement::Face(colour(c.dimension)),
                 ChannelKind::Color => Placement::Vertex(colour(c.dimension)),
                 ChannelKind::Generic => {
-                    let names: Vec<String> = if c.dimension == 1 {
-                        vec![c.name.clone()]
-                    } else {
-                        (0..c.dimension)
-                            .map(|k| format!("{}_{k}", c.name))
-                            .collect()
-                    };
+                    let names = generic_property_names(&c.name, c.dimension);
                     if !is_writable_name(c.name.as_bytes()) {
                         Placement::Left("a PLY property name cannot be empty or hold spaces")
                     } else if names.iter().any(|n| is_reserved(n.as_bytes())) {
