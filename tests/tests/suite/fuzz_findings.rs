@@ -404,3 +404,30 @@ fn a_ply_property_name_two_channels_would_write_is_read_once() {
     assert_eq!(names, [("flow", 2)]);
     assert_eq!(loaded.notes.skipped_properties, 1);
 }
+
+/// read_off finding 21 (`vertex_and_face_colour_on_a_degenerate_face`, also in PLY):
+/// with every triangle repeating one vertex (`3 0 0 0`), the vertex colour also has one
+/// value per triangle, so both colours looked like face colours: the first took the
+/// face slot and the second was left out. Of two such colours the first now goes on the
+/// vertices, where the readers' vertex colour came from.
+#[test]
+fn a_vertex_and_a_face_colour_on_degenerate_faces_both_survive() {
+    use qem_mesh::io::{read_bytes, write_to, Format};
+    for (target, format) in [("read_off", Format::Off), ("read_ply", Format::Ply)] {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../fuzz/regressions")
+            .join(target)
+            .join("vertex_and_face_colour_on_a_degenerate_face");
+        let data = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let read = |bytes: &[u8]| {
+            read_bytes(bytes, format)
+                .unwrap_or_else(|e| panic!("{target}: refused: {e}"))
+                .mesh
+        };
+        let first = read(&data);
+        assert_eq!(channel_names(&first), ["colour", "face_colour"], "{target}");
+        let mut written = Vec::new();
+        write_to(&mut written, &first, format).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(read(&written), first, "{target}");
+    }
+}

@@ -54,6 +54,27 @@ pub(crate) fn is_face_colour(c: &Channel) -> bool {
     c.kind == ChannelKind::Color && c.corners.iter().all(|&[a, b, d]| a == b && b == d)
 }
 
+/// Which of `channels` PLY and OFF write on the faces: the colours with one value per
+/// triangle ([`is_face_colour`]), except that when every colour has one value per
+/// triangle and there are two or more, the first goes on the vertices.
+///
+/// Why: a vertex colour also has one value per triangle when every triangle repeats one
+/// vertex (a file of degenerate faces `3 0 0 0`), and then the file's vertex and face
+/// colours looked alike; the first took the face slot and the second was left out (a
+/// read_off finding). The readers put the vertex colour first, so each goes back where
+/// it came from; and in any mesh a second such colour is written (per vertex) rather
+/// than left out.
+pub(crate) fn colours_on_faces(channels: &[Channel]) -> Vec<bool> {
+    let mut on_face: Vec<bool> = channels.iter().map(is_face_colour).collect();
+    let colours: Vec<usize> = (0..channels.len())
+        .filter(|&i| channels[i].kind == ChannelKind::Color)
+        .collect();
+    if colours.len() >= 2 && colours.iter().all(|&i| on_face[i]) {
+        on_face[colours[0]] = false;
+    }
+    on_face
+}
+
 /// An integer colour level `level` out of `max` (255 for `uchar`) as a float in 0–1.
 /// The writers use the same function to check that a float is exactly a level, so
 /// `uchar` colours read back bit-exact.

@@ -43,7 +43,7 @@ use std::io::Write;
 
 use smallvec::SmallVec;
 
-use super::channels::{is_face_colour, per_vertex, unit_colours};
+use super::channels::{colours_on_faces, per_vertex, unit_colours};
 use super::text::{self, capacity_for, parse_f32, parse_f64, parse_i64, show, words};
 use super::{sniff, Format, Location, ReadError, ReadNotes};
 use crate::attributes::{Attributes, Channel, ChannelKind};
@@ -374,27 +374,25 @@ pub(crate) enum Slot {
 
 /// Where [`write`] puts each of `channels`: the first normals, the first colour that
 /// is not per face and the first texture coordinates on the vertices (NOFF, COFF,
-/// STOFF), the first colour with one value per triangle on the faces; nothing else
-/// has a place in OFF.
+/// STOFF), the first colour with one value per triangle on the faces (see
+/// [`colours_on_faces`] for two of them); nothing else has a place in OFF.
 pub(crate) fn slots(channels: &[Channel]) -> Vec<Slot> {
     let mut taken: Vec<(ChannelKind, bool)> = Vec::new();
     channels
         .iter()
-        .map(|c| {
-            let on_face = is_face_colour(c);
-            match c.kind {
-                ChannelKind::Generic => Slot::Left("OFF holds no generic channels"),
-                _ if !taken.contains(&(c.kind, on_face)) => {
-                    taken.push((c.kind, on_face));
-                    if on_face {
-                        Slot::Face
-                    } else {
-                        Slot::Vertex
-                    }
+        .zip(colours_on_faces(channels))
+        .map(|(c, on_face)| match c.kind {
+            ChannelKind::Generic => Slot::Left("OFF holds no generic channels"),
+            _ if !taken.contains(&(c.kind, on_face)) => {
+                taken.push((c.kind, on_face));
+                if on_face {
+                    Slot::Face
+                } else {
+                    Slot::Vertex
                 }
-                ChannelKind::Color => Slot::Left("OFF holds one vertex colour and one face colour"),
-                _ => Slot::Left("OFF holds one texture coordinate and one normal per vertex"),
             }
+            ChannelKind::Color => Slot::Left("OFF holds one vertex colour and one face colour"),
+            _ => Slot::Left("OFF holds one texture coordinate and one normal per vertex"),
         })
         .collect()
 }

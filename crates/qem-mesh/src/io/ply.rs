@@ -55,7 +55,7 @@
 
 use std::io::Write;
 
-use super::channels::{all_levels, from_level, is_face_colour, per_vertex, to_level};
+use super::channels::{all_levels, colours_on_faces, from_level, per_vertex, to_level};
 use super::off::fan;
 use super::text::{self, capacity_for, parse_f32, parse_f64, parse_i64, show, Tokens};
 use super::{sniff, Format, Location, ReadError, ReadNotes};
@@ -1161,8 +1161,9 @@ pub(crate) enum Placement {
 
 /// Where [`write`] puts each of `channels`: the first texture coordinates as `s t`, the
 /// first normals as `nx ny nz`, the first colour with one value per triangle as the
-/// faces' `red green blue [alpha]` and the first other colour as the vertices',
-/// generic channels under their names (`<name>_0`, `<name>_1`... for vectors), at most
+/// faces' `red green blue [alpha]` and the first other colour as the vertices' (of two
+/// colours that both have one value per triangle, the first goes on the vertices:
+/// `channels::colours_on_faces`), generic channels under their names (`<name>_0`, `<name>_1`... for vectors), at most
 /// [`MAX_CHANNELS`] in all (what the reader reads back).
 pub(crate) fn placements(channels: &[Channel]) -> Vec<Placement> {
     let mut used: Vec<String> = Vec::new();
@@ -1176,8 +1177,8 @@ pub(crate) fn placements(channels: &[Channel]) -> Vec<Placement> {
     };
     channels
         .iter()
-        .map(|c| {
-            let on_face = is_face_colour(c);
+        .zip(colours_on_faces(channels))
+        .map(|(c, on_face)| {
             let taken = kinds.contains(&(c.kind, on_face));
             let placement = match c.kind {
                 _ if count >= MAX_CHANNELS => {
