@@ -12,7 +12,7 @@ secs=${SECONDS_PER_TARGET:-600}
 work=${FUZZ_WORK:-/tmp/qem-fuzz}
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
-  targets=(read_obj read_ply read_stl read_off simplify_soup store_ops grid_pairs quadric_solve)
+  targets=(read_obj read_ply read_stl read_off read_gltf simplify_soup store_ops grid_pairs quadric_solve)
 fi
 mkdir -p "$work/logs"
 for t in "${targets[@]}"; do

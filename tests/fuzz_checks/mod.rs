@@ -14,7 +14,7 @@ mod store_ops;
 
 pub use grid_pairs::grid_pairs;
 pub use quadric::quadric_solve;
-pub use readers::{read_checked, read_obj, read_off, read_ply, read_stl};
+pub use readers::{read_checked, read_gltf, read_obj, read_off, read_ply, read_stl};
 pub use simplify_soup::simplify_soup;
 pub use store_ops::store_ops;
 
@@ -22,7 +22,7 @@ pub use store_ops::store_ops;
 pub type Check = fn(&[u8]);
 
 /// Every fuzz target by name with its check, for the replay test and for tools.
-pub const TARGETS: [(&str, Check); 8] = [
+pub const TARGETS: [(&str, Check); 9] = [
     ("quadric_solve", quadric_solve),
     ("simplify_soup", simplify_soup),
     ("store_ops", store_ops),
@@ -31,4 +31,5 @@ pub const TARGETS: [(&str, Check); 8] = [
     ("read_ply", read_ply),
     ("read_stl", read_stl),
     ("read_off", read_off),
+    ("read_gltf", read_gltf),
 ];

@@ -171,3 +171,263 @@ fn stl_output_refuses_coordinates_beyond_float32() {
     let mut bytes = Vec::new();
     qem_mesh::io::write_to(&mut bytes, &edge, qem_mesh::io::Format::Stl).expect("fits");
 }
+
+/// A read_gltf reproducer (`fuzz/regressions/read_gltf/NAME`), read as glTF, and the same
+/// mesh after a trip through GLB.
+fn gltf_round_trip(name: &str) -> (IndexedMesh, IndexedMesh) {
+    use qem_mesh::io::{read_bytes, write_to, Format};
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../fuzz/regressions/read_gltf")
+        .join(name);
+    let data = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let read = |bytes: &[u8], format| {
+        read_bytes(bytes, format)
+            .unwrap_or_else(|e| panic!("{name}: refused: {e}"))
+            .mesh
+    };
+    let first = read(&data, Format::Gltf);
+    let mut glb = Vec::new();
+    write_to(&mut glb, &first, Format::Glb).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let again = read(&glb, Format::Glb);
+    (first, again)
+}
+
+/// The channels' names, in order.
+fn channel_names(mesh: &IndexedMesh) -> Vec<&str> {
+    let channels = &mesh.attributes.channels;
+    channels.iter().map(|c| c.name.as_str()).collect()
+}
+
+/// read_gltf finding 11 (`lone_texcoord_1*`): a primitive with `TEXCOORD_1` and no
+/// `TEXCOORD_0` (which the specification forbids, but files have) gave a channel `uv1`;
+/// the writer numbers sets from 0, as it must, so it came back as `uv`. Sets are now
+/// named by their rank among the file's sets of their kind.
+#[test]
+fn a_lone_texcoord_1_is_named_uv_and_keeps_its_name_through_glb() {
+    let (first, again) = gltf_round_trip("lone_texcoord_1_gltf");
+    assert_eq!(channel_names(&first), ["uv"]);
+    assert_eq!(channel_names(&again), ["uv"]);
+    let uv = |m: &IndexedMesh| {
+        m.attributes.channels[0]
+            .at_corner(0, 1)
+            .map(<[f32]>::to_vec)
+    };
+    assert_eq!(uv(&first), Some(vec![1.0, 1.0]), "v is flipped on reading");
+    assert_eq!(uv(&again), uv(&first));
+}
+
+/// read_gltf finding 12 (`negative_zero_in_float32*`): a node scale of 1e-30 puts a
+/// vertex at x = -1e-50, which float32 holds as -0.0; reading the written file back
+/// ran it through the identity transform, whose additions give +0.0, so the position's
+/// bits changed. Untransformed positions are now taken as they are.
+#[test]
+fn a_position_that_float32_rounds_to_negative_zero_keeps_its_sign() {
+    let (first, again) = gltf_round_trip("negative_zero_in_float32_gltf");
+    assert!(first.positions[0][0] < 0.0 && first.positions[0][0] > -1e-49);
+    assert_eq!(again.positions[0][0].to_bits(), (-0.0f64).to_bits());
+}
+
+/// read_gltf finding 13 (`one_material_with_and_without_uv*`): two primitives of one
+/// material (here none), one with `TEXCOORD_0` and one without, were written as one
+/// primitive with `TEXCOORD_0`, so the second's faces came back with the zeros the
+/// shared accessor holds for them. The writer now gives faces with and without a
+/// channel primitives of their own.
+#[test]
+fn faces_of_one_material_without_a_channel_come_back_without_it() {
+    let (first, again) = gltf_round_trip("one_material_with_and_without_uv_gltf");
+    for mesh in [&first, &again] {
+        assert_eq!(mesh.triangle_count(), 2);
+        let uv = &mesh.attributes.channels[0];
+        assert!(uv.at_corner(0, 0).is_some(), "the first primitive has uvs");
+        assert_eq!(uv.at_corner(1, 0), None, "the fan has none");
+    }
+}
+
+/// read_gltf finding 14 (`texcoord_of_a_primitive_without_triangles*`): a strip of
+/// two vertices (no triangle) with `TEXCOORD_0` gave a channel `uv` that no corner
+/// has, and the triangle's `TEXCOORD_1` the channel `uv1`; the writer wrote `uv1` as
+/// `TEXCOORD_1` beside an unused `TEXCOORD_0`, which read back as `uv`. Only attributes
+/// some triangle uses now make channels.
+#[test]
+fn an_attribute_only_a_primitive_without_triangles_has_makes_no_channel() {
+    let (first, again) = gltf_round_trip("texcoord_of_a_primitive_without_triangles_gltf");
+    assert_eq!(first.triangle_count(), 1);
+    assert_eq!(channel_names(&first), ["uv"]);
+    assert_eq!(channel_names(&again), ["uv"]);
+}
+
+/// The colours of `name`'s first vertex (a `fuzz/regressions/TARGET` reproducer), read
+/// in `format`, and after a trip through the same format.
+fn first_colour_round_trip(
+    target: &str,
+    name: &str,
+    format: qem_mesh::io::Format,
+) -> (Vec<f32>, Vec<f32>) {
+    use qem_mesh::attributes::ChannelKind;
+    use qem_mesh::io::{read_bytes, write_to};
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../fuzz/regressions")
+        .join(target)
+        .join(name);
+    let data = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let read = |bytes: &[u8]| {
+        read_bytes(bytes, format)
+            .unwrap_or_else(|e| panic!("{name}: refused: {e}"))
+            .mesh
+    };
+    let colour = |mesh: &IndexedMesh| -> Vec<f32> {
+        let channel = mesh.attributes.channel(ChannelKind::Color);
+        channel
+            .and_then(|c| c.at_corner(0, 0))
+            .unwrap_or_default()
+            .to_vec()
+    };
+    let first = read(&data);
+    let mut written = Vec::new();
+    write_to(&mut written, &first, format).unwrap_or_else(|e| panic!("{name}: {e}"));
+    (colour(&first), colour(&read(&written)))
+}
+
+/// read_obj finding 15 (`colour_level_above_255`, found by the attribute round trip
+/// on a hand-made file before the run): `v 0 0 0 300 0 0` makes the file's colours
+/// 0–255 levels, and 300/255 ≈ 1.18 was kept; written back, that value above 1 made
+/// the levels rule divide every colour by 255 again. Colours are now clamped to 0–1
+/// after the rule, in OBJ and OFF.
+#[test]
+fn an_obj_colour_level_above_255_is_clamped_and_survives_a_round_trip() {
+    let (first, again) = first_colour_round_trip(
+        "read_obj",
+        "colour_level_above_255",
+        qem_mesh::io::Format::Obj,
+    );
+    assert_eq!(first, [1.0, 0.0, 0.0]);
+    assert_eq!(again, first);
+}
+
+/// read_off finding 16 (`negative_colour`, found like finding 15): a COFF colour of
+/// −1 was kept (no component above 1, so not levels), and the writer, which clamps
+/// colours to 0–1, wrote 0. The reader now clamps too.
+#[test]
+fn a_negative_off_colour_is_clamped_and_survives_a_round_trip() {
+    let (first, again) =
+        first_colour_round_trip("read_off", "negative_colour", qem_mesh::io::Format::Off);
+    assert_eq!(first, [0.0, 0.0, 0.0]);
+    assert_eq!(again, first);
+}
+
+/// read_obj finding 17 (`mixed_face_after_*`): a face where some corners have a `vn`
+/// (or `vt`) and others not, after faces where none has, lost the values of the
+/// corners that have one: the run of faces without normals ran on over it, and only
+/// a mixed face's missing corners were meant to be marked. Found by the attribute
+/// round trip, where the writer's own `f 4 4//2 5//2` lost them on reading back; the
+/// first reading of such a file lost them as well.
+#[test]
+fn a_mixed_face_after_faces_without_normals_keeps_its_normals() {
+    use qem_mesh::attributes::ChannelKind;
+    use qem_mesh::io::{read_bytes, Format};
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../fuzz/regressions/read_obj/mixed_face_after_a_face_without_vn");
+    let data = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mesh = read_bytes(&data, Format::Obj)
+        .unwrap_or_else(|e| panic!("refused: {e}"))
+        .mesh;
+    let normal = mesh
+        .attributes
+        .channel(ChannelKind::Normal)
+        .unwrap_or_else(|| panic!("no normals"));
+    let has = |t: usize| [0, 1, 2].map(|k| normal.at_corner(t, k).is_some());
+    assert_eq!(has(0), [false; 3]);
+    assert_eq!(has(1), [false, true, true]);
+}
+
+/// read_ply finding 18 (`control_byte*_in_property_name*`, `vector_without_a_name`):
+/// the reader made generic channels of properties whose names no PLY file can hold (a
+/// fuzzed header had `diff&use\0\x0b_red`; `_0 _1` made a vector named ""), which the
+/// writer then left out, so a round trip lost them. The reader now skips them too.
+#[test]
+fn ply_properties_the_writer_cannot_name_are_skipped() {
+    use qem_mesh::io::{read_bytes, Format};
+    for name in ["control_byte_in_property_name", "vector_without_a_name"] {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../fuzz/regressions/read_ply")
+            .join(name);
+        let data = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let loaded = read_bytes(&data, Format::Ply).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert!(loaded.mesh.attributes.channels.is_empty(), "{name}");
+        assert!(loaded.notes.skipped_properties > 0, "{name}");
+    }
+}
+
+/// read_obj finding 19 (`names_ending_in_a_backslash`): a group, material or material
+/// library name that ends in a backslash (`g seg \` followed by a space, which the
+/// reader trims) was written as `g seg \` and a line break, which OBJ reads as a line
+/// continuation: the next line (a face, a vertex) became part of the name. The writer
+/// now puts a space after such a name.
+#[test]
+fn obj_names_ending_in_a_backslash_survive_a_round_trip() {
+    use qem_mesh::io::{read_bytes, write_to, Format};
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../fuzz/regressions/read_obj/names_ending_in_a_backslash");
+    let data = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let read = |bytes: &[u8]| {
+        read_bytes(bytes, Format::Obj)
+            .unwrap_or_else(|e| panic!("refused: {e}"))
+            .mesh
+    };
+    let first = read(&data);
+    let names = &first.attributes;
+    assert_eq!(names.groups.names, [b"seg \\".to_vec()]);
+    assert_eq!(names.materials.names, [b"red\\\\".to_vec()]);
+    assert_eq!(names.material_libraries, [b"lib\\".to_vec()]);
+    let mut written = Vec::new();
+    write_to(&mut written, &first, Format::Obj).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(read(&written), first);
+}
+
+/// read_ply finding 20 (`property_names_*twice*`): `flow_0 flow_1` and a second
+/// `flow_0` (or two names that differ only in bytes that are not UTF-8) gave a vector
+/// channel `flow` and a scalar `flow_0`, which the writer would both write as `flow_0`;
+/// it leaves the second out, so a round trip lost it. The reader now skips a generic
+/// channel whose property names an earlier one has.
+#[test]
+fn a_ply_property_name_two_channels_would_write_is_read_once() {
+    use qem_mesh::io::{read_bytes, Format};
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../fuzz/regressions/read_ply/property_names_of_a_vector_twice");
+    let data = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let loaded = read_bytes(&data, Format::Ply).unwrap_or_else(|e| panic!("{e}"));
+    let channels = &loaded.mesh.attributes.channels;
+    let names: Vec<(&str, usize)> = channels
+        .iter()
+        .map(|c| (c.name.as_str(), c.dimension))
+        .collect();
+    assert_eq!(names, [("flow", 2)]);
+    assert_eq!(loaded.notes.skipped_properties, 1);
+}
+
+/// read_off finding 21 (`vertex_and_face_colour_on_a_degenerate_face`, also in PLY):
+/// with every triangle repeating one vertex (`3 0 0 0`), the vertex colour also has one
+/// value per triangle, so both colours looked like face colours: the first took the
+/// face slot and the second was left out. Of two such colours the first now goes on the
+/// vertices, where the readers' vertex colour came from.
+#[test]
+fn a_vertex_and_a_face_colour_on_degenerate_faces_both_survive() {
+    use qem_mesh::io::{read_bytes, write_to, Format};
+    for (target, format) in [("read_off", Format::Off), ("read_ply", Format::Ply)] {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../fuzz/regressions")
+            .join(target)
+            .join("vertex_and_face_colour_on_a_degenerate_face");
+        let data = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let read = |bytes: &[u8]| {
+            read_bytes(bytes, format)
+                .unwrap_or_else(|e| panic!("{target}: refused: {e}"))
+                .mesh
+        };
+        let first = read(&data);
+        assert_eq!(channel_names(&first), ["colour", "face_colour"], "{target}");
+        let mut written = Vec::new();
+        write_to(&mut written, &first, format).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(read(&written), first, "{target}");
+    }
+}

@@ -79,6 +79,7 @@ replay_tests! {
     replay_read_ply: "read_ply",
     replay_read_stl: "read_stl",
     replay_read_off: "read_off",
+    replay_read_gltf: "read_gltf",
 }
 
 /// Every directory under `fuzz/corpus` and `fuzz/regressions` belongs to a target, so

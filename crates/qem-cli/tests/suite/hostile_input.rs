@@ -632,3 +632,44 @@ fn stl_output_beyond_float32_is_refused_without_a_file() {
         .collect();
     assert_eq!(names, vec![std::ffi::OsString::from("huge.obj")]);
 }
+
+/// A `.gltf` triangle whose one buffer is `buffer` (its `uri` and `byteLength`).
+fn gltf_triangle(buffer: &str) -> Vec<u8> {
+    format!(
+        "{{\"asset\":{{\"version\":\"2.0\"}},\
+         \"meshes\":[{{\"primitives\":[{{\"attributes\":{{\"POSITION\":0}}}}]}}],\
+         \"accessors\":[{{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}}],\
+         \"bufferViews\":[{{\"buffer\":0,\"byteLength\":36}}],\
+         \"buffers\":[{buffer}]}}"
+    )
+    .into_bytes()
+}
+
+/// Issue 29: hostile attribute files are refused like hostile geometry, with the place.
+#[test]
+fn hostile_attribute_files_are_refused_with_their_place() {
+    assert_refused(
+        "nan_vt.obj",
+        format!("{TRIANGLE_VERTICES}vt 0 0\nvt nan 0\nf 1/1 2/2 3/1\n").as_bytes(),
+        "line 5: texture coordinate 1: \"nan\" is not a finite 32-bit float",
+    );
+    assert_refused(
+        "vt_out_of_range.obj",
+        format!("{TRIANGLE_VERTICES}vt 0 0\nf 1/1 2/2 3/1\n").as_bytes(),
+        "line 5: face 0 refers to texture coordinate 2, but there are only 1 texture \
+         coordinates",
+    );
+    // The buffer file is not in the directory: nothing but the input is.
+    assert_refused(
+        "missing_buffer.gltf",
+        &gltf_triangle("{\"uri\":\"tri.bin\",\"byteLength\":36}"),
+        "buffer 0: cannot read its file \"tri.bin\": No such file or directory (os error 2)",
+    );
+    assert_refused(
+        "billion.gltf",
+        &gltf_triangle(
+            "{\"uri\":\"data:application/octet-stream;base64,AAAA\",\"byteLength\":1000000000}",
+        ),
+        "unexpected end of file in buffer 0: it holds 3 bytes, its byteLength says 1000000000",
+    );
+}

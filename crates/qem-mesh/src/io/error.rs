@@ -69,7 +69,10 @@ pub enum ReadErrorKind {
     Mesh(InputError),
     /// An external buffer file of a `.gltf` could not be read.
     BufferFile {
-        /// The file as the glTF names it.
+        /// The buffer's index in the glTF's `buffers`.
+        buffer: usize,
+        /// The file as the glTF names it, percent escapes decoded (`data%20file.bin` is
+        /// `data file.bin`), relative to the `.gltf` file's directory.
         uri: String,
         /// The operating system's error.
         detail: String,
@@ -186,8 +189,12 @@ impl fmt::Display for ReadErrorKind {
             }
             ReadErrorKind::Mesh(e) => write!(f, "{e}"),
             ReadErrorKind::Gzip { detail } => write!(f, "gzip: {detail}"),
-            ReadErrorKind::BufferFile { uri, detail } => {
-                write!(f, "buffer file {uri:?}: cannot read: {detail}")
+            ReadErrorKind::BufferFile {
+                buffer,
+                uri,
+                detail,
+            } => {
+                write!(f, "buffer {buffer}: cannot read its file {uri:?}: {detail}")
             }
         }
     }

@@ -17,7 +17,9 @@
 //!   counted in [`ReadNotes::skipped_primitives`].
 //! - **Attributes.** `TEXCOORD_0` becomes the texture coordinate channel `uv`,
 //!   `NORMAL` the normal channel, `COLOR_0` (vec3 or vec4) the colour channel; further
-//!   sets become `uv1`, `colour1`...; application-specific attributes `_NAME` (scalar
+//!   sets become `uv1`, `colour1`... in the order of their numbers (a file that skips
+//!   a number, which the specification forbids, has its sets named as if it did not,
+//!   as the writer numbers them); application-specific attributes `_NAME` (scalar
 //!   to vec4) become generic channels named `NAME`. Any component type is read, with
 //!   `normalized` integers mapped to 0–1 or −1–1. `TANGENT`, `JOINTS_n` and
 //!   `WEIGHTS_n` are skipped and counted in [`ReadNotes::skipped_properties`] (tangents
@@ -39,7 +41,12 @@
 //!   extensions and `KHR_mesh_quantization` are fine); node graphs that are not trees;
 //!   external buffer files when reading from memory ([`super::read_bytes`] cannot
 //!   resolve them; [`super::read_path`] reads them relative to the `.gltf` file, and
-//!   refuses absolute paths and URLs).
+//!   refuses absolute paths and URLs); a buffer that holds less than its
+//!   `byteLength` (a `data:` URI's length is checked before it is decoded, and a
+//!   buffer file is read no further than the declared length, so a size the file only
+//!   claims is never allocated); accessors, buffer views and indices that reach past
+//!   what is there; a NaN or infinite value in a float accessor, naming the accessor
+//!   and the element (positions, normals, texture coordinates and colours alike).
 //! - **Lenient:** a `POSITION` accessor without the `min`/`max` the specification asks
 //!   for is accepted (qem does not use them).
 //!
@@ -52,8 +59,10 @@
 //! an `InvalidInput` error); the first normal channel as `NORMAL`, texture coordinate
 //! channels as `TEXCOORD_0`, `TEXCOORD_1`..., colours as `COLOR_0`... (`float32`), and
 //! generic channels as `_NAME`; one glTF mesh per group (named after it) and within
-//! it one primitive per material, with `u32` indices; every vertex accessor is shared
-//! by all primitives. The materials are written as glTF materials carrying only their
+//! it one primitive per material and set of channels present (faces without a value
+//! in a channel get a primitive without that attribute, so they read back without
+//! one), with `u32` indices; every vertex accessor is shared by all primitives. A
+//! face with a value at some corners only has zeros at the others. The materials are written as glTF materials carrying only their
 //! names. Names that are not UTF-8 are written with U+FFFD in place of invalid bytes.
 //!
 //! # What is not carried through
@@ -65,7 +74,7 @@
 //! names but default (white, PBR metallic-roughness) materials without textures.
 //! Keeping them would need the source document inside the mesh; that is not done.
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::{BTreeMap, HashMap, HashSet};
 use std::io::{self, Write};
 
 use glam::{DMat3, DMat4, DQuat, DVec3};
@@ -80,8 +89,9 @@ use crate::attributes::{Attributes, Channel, ChannelKind, FaceLabels};
 use crate::{IndexedMesh, MAX_ELEMENTS};
 
 /// Opens an external buffer for [`read`]: given its URI (percent-decoded, a relative
-/// path) and the byte count the file declares, gives at least that many bytes.
-pub(crate) type External<'a> = &'a dyn Fn(&str, usize) -> Result<Vec<u8>, ReadError>;
+/// path) and the byte count the glTF declares, gives at most that many bytes (fewer
+/// when the file is shorter, which [`read`] reports with the buffer's index).
+pub(crate) type External<'a> = &'a dyn Fn(&str, usize) -> std::io::Result<Vec<u8>>;
 
 /// The GLB magic, chunk types and the header sizes.
 const GLB_MAGIC: &[u8; 4] = b"glTF";
@@ -275,14 +285,24 @@ fn document(json_text: &[u8]) -> Result<Root, ReadError> {
     Ok(root)
 }
 
+/// Base64 text without its padding (`=` or `==` at the end).
+fn unpadded(text: &[u8]) -> &[u8] {
+    text.strip_suffix(b"==")
+        .or(text.strip_suffix(b"="))
+        .unwrap_or(text)
+}
+
+/// How many bytes [`decode_base64`] gives for `text` when it is valid, found without
+/// decoding: each character carries 6 bits, and a partial byte at the end is dropped.
+fn decoded_len(text: &[u8]) -> usize {
+    unpadded(text).len() / 4 * 3 + unpadded(text).len() % 4 * 3 / 4
+}
+
 /// Decodes standard or URL-safe base64, with or without padding; `None` on any other
 /// byte.
 fn decode_base64(text: &[u8]) -> Option<Vec<u8>> {
-    let text = text
-        .strip_suffix(b"==")
-        .or(text.strip_suffix(b"="))
-        .unwrap_or(text);
-    let mut out = Vec::with_capacity(text.len() / 4 * 3 + 2);
+    let text = unpadded(text);
+    let mut out = Vec::with_capacity(decoded_len(text));
     let (mut acc, mut bits) = (0u32, 0u32);
     for &c in text {
         let v = match c {
@@ -381,6 +401,16 @@ fn load_buffers(
             continue;
         }
         let declared = usize::try_from(buffer.byte_length.0).unwrap_or(usize::MAX);
+        let short = |held: usize| {
+            ReadError::new(
+                ReadErrorKind::Truncated {
+                    detail: format!(
+                        "in buffer {i}: it holds {held} bytes, its byteLength says {declared}"
+                    ),
+                },
+                None,
+            )
+        };
         let data = match buffer.uri.as_deref() {
             None => bin
                 .ok_or_else(|| {
@@ -395,6 +425,12 @@ fn load_buffers(
                     return Err(malformed(format!(
                         "buffer {i}: a data URI that is not base64 ({header:?})"
                     )));
+                }
+                // Refused before decoding when the text is too short for the declared
+                // length, so a short URI that claims 10^9 bytes costs nothing.
+                let held = decoded_len(payload.as_bytes());
+                if held < declared {
+                    return Err(short(held));
                 }
                 decode_base64(payload.as_bytes()).ok_or_else(|| {
                     malformed(format!("buffer {i}: the data URI is not valid base64"))
@@ -419,19 +455,20 @@ fn load_buffers(
                         "buffer {i}: the URI {uri:?} is not a relative file path"
                     )));
                 }
-                open(&path, declared)?
+                open(&path, declared).map_err(|e| {
+                    ReadError::new(
+                        ReadErrorKind::BufferFile {
+                            buffer: i,
+                            uri: path.clone(),
+                            detail: e.to_string(),
+                        },
+                        None,
+                    )
+                })?
             }
         };
         if data.len() < declared {
-            return Err(ReadError::new(
-                ReadErrorKind::Truncated {
-                    detail: format!(
-                        "in buffer {i}: it holds {} bytes, its byteLength says {declared}",
-                        data.len()
-                    ),
-                },
-                None,
-            ));
+            return Err(short(data.len()));
         }
         let mut data = data;
         data.truncate(declared);
@@ -442,6 +479,8 @@ fn load_buffers(
 
 /// An accessor's elements, checked to lie within its buffer view and buffer.
 struct Elements<'b> {
+    /// The accessor for messages: `accessor 3 (NORMAL of mesh 0 primitive 1)`.
+    name: String,
     /// From the first element's first byte to the last element's last byte.
     data: &'b [u8],
     count: usize,
@@ -534,6 +573,7 @@ fn elements<'b>(
         )));
     };
     Ok(Elements {
+        name: format!("accessor {i} ({what})"),
         data: &buffer[start as usize..end as usize],
         count: count as usize,
         stride,
@@ -578,6 +618,22 @@ impl Elements<'_> {
         out
     }
 
+    /// [`Self::floats`], refusing a value that is not finite (NaN or an infinity in a
+    /// float accessor) with the accessor and the element: the mesh's validation would
+    /// refuse it too, but could not say where it came from.
+    fn finite_floats(&self) -> Result<Vec<f32>, ReadError> {
+        let v = self.floats();
+        match v.iter().position(|x| !x.is_finite()) {
+            Some(k) => Err(malformed(format!(
+                "{}: element {} holds {}, not a finite number",
+                self.name,
+                k / self.components,
+                v[k]
+            ))),
+            None => Ok(v),
+        }
+    }
+
     /// The elements as vertex indices (unsigned integer scalars).
     fn indices(&self, what: &str) -> Result<Vec<u32>, ReadError> {
         let unsigned = matches!(
@@ -612,11 +668,18 @@ impl Key {
         }
     }
 
-    /// The channel's name, before making it unique.
-    fn name(&self) -> String {
+    /// The channel's name, before making it unique, for the set that is number `rank`
+    /// among the file's sets of its kind (`TEXCOORD_1` alone is rank 0).
+    ///
+    /// Sets are named by rank rather than by their glTF number because the writer
+    /// numbers them from 0 without gaps, as the specification requires: naming
+    /// `TEXCOORD_1` alone `uv1` would make it `uv` after a round trip.
+    fn name(&self, rank: usize) -> String {
         match self {
-            Key::TexCoord(0) | Key::Normal | Key::Color(0) => self.kind().as_str().to_string(),
-            Key::TexCoord(n) | Key::Color(n) => format!("{}{n}", self.kind().as_str()),
+            Key::TexCoord(_) | Key::Color(_) if rank > 0 => {
+                format!("{}{rank}", self.kind().as_str())
+            }
+            Key::TexCoord(_) | Key::Normal | Key::Color(_) => self.kind().as_str().to_string(),
             Key::Custom(name) => name.clone(),
         }
     }
@@ -991,10 +1054,16 @@ fn read_positions(
         return Err(malformed(format!("{what}: POSITION must be VEC3")));
     }
     let mut positions = Vec::with_capacity(pos.count);
-    for (v, c) in pos.floats().chunks_exact(3).enumerate() {
-        let p = placed
-            .world
-            .transform_point3(DVec3::new(c[0].into(), c[1].into(), c[2].into()));
+    // Untransformed positions are kept as they are: the identity's arithmetic turns
+    // -0.0 into 0.0, and a round trip through glTF would then not be bit for bit.
+    let identity = placed.world == DMat4::IDENTITY;
+    for (v, c) in pos.finite_floats()?.chunks_exact(3).enumerate() {
+        let c = DVec3::new(c[0].into(), c[1].into(), c[2].into());
+        let p = if identity {
+            c
+        } else {
+            placed.world.transform_point3(c)
+        };
         if !p.is_finite() {
             return Err(malformed(format!(
                 "{what}: vertex {v} is not finite after its node's transform"
@@ -1033,7 +1102,7 @@ fn read_attribute(
             e.components
         )));
     }
-    let mut v = e.floats();
+    let mut v = e.finite_floats()?;
     match key {
         Key::TexCoord(_) => {
             for uv in v.chunks_exact_mut(2) {
@@ -1043,10 +1112,17 @@ fn read_attribute(
         // Untransformed normals are kept bit for bit, so a round trip through glTF
         // does not renormalise them.
         Key::Normal if normal_matrix != DMat3::IDENTITY => {
-            for n in v.chunks_exact_mut(3) {
+            for (k, n) in v.chunks_exact_mut(3).enumerate() {
                 let m = normal_matrix * DVec3::new(n[0].into(), n[1].into(), n[2].into());
-                let m = m.try_normalize().unwrap_or(m);
-                n.copy_from_slice(&m.as_vec3().to_array());
+                // A normal too long to normalise (its squared length overflows) stays
+                // as it is, and may then be beyond float32.
+                let m = m.try_normalize().unwrap_or(m).as_vec3();
+                if !m.is_finite() {
+                    return Err(malformed(format!(
+                        "{what}: NORMAL element {k} is not finite after its node's transform"
+                    )));
+                }
+                n.copy_from_slice(&m.to_array());
             }
         }
         _ => {}
@@ -1067,9 +1143,18 @@ fn flip_v(v: f32) -> f32 {
 /// One mesh from the blocks and runs: positions and triangles concatenated, a
 /// channel per attribute key any block has (missing where a block lacks it).
 fn assemble(blocks: Vec<Block>, runs: Vec<Run>, materials: Labels, groups: Labels) -> IndexedMesh {
+    // Only attributes some triangle uses make channels, with the dimension of those
+    // uses: a primitive without triangles (a strip of two indices) would otherwise
+    // give a channel no corner has, which the writer cannot write back as such (it
+    // would shift the numbering of the sets that are used, or widen vec3 colours).
+    let used: HashSet<(usize, &Key)> = runs
+        .iter()
+        .filter(|r| !r.triangles.is_empty())
+        .flat_map(|r| r.keys.iter().map(|k| (r.block, k)))
+        .collect();
     let mut dims: BTreeMap<Key, usize> = BTreeMap::new();
-    for block in &blocks {
-        for (key, v) in &block.values {
+    for &(b, key) in &used {
+        if let Some(v) = blocks[b].values.get(key) {
             let e = dims.entry(key.clone()).or_insert(v.dimension);
             *e = (*e).max(v.dimension);
         }
@@ -1081,10 +1166,13 @@ fn assemble(blocks: Vec<Block>, runs: Vec<Run>, materials: Labels, groups: Label
         positions.extend_from_slice(&b.positions);
     }
     let mut names: Vec<String> = Vec::new();
-    let mut channels = Vec::new();
+    let mut channels: Vec<Channel> = Vec::new();
     for (key, dim) in dims {
+        // The keys come sorted, so a set's rank is the number of channels of its kind
+        // before it.
+        let rank = channels.iter().filter(|c| c.kind == key.kind()).count();
         // Unique names: a `_NAME` attribute may be called like a standard channel.
-        let base = key.name();
+        let base = key.name(rank);
         let mut name = base.clone();
         let mut k = 1;
         while names.contains(&name) {
@@ -1094,8 +1182,8 @@ fn assemble(blocks: Vec<Block>, runs: Vec<Run>, materials: Labels, groups: Label
         names.push(name.clone());
         let mut values = Vec::new();
         let mut base = Vec::with_capacity(blocks.len());
-        for b in &blocks {
-            match b.values.get(&key) {
+        for (bi, b) in blocks.iter().enumerate() {
+            match b.values.get(&key).filter(|_| used.contains(&(bi, &key))) {
                 Some(v) => {
                     base.push(Some((values.len() / dim) as u32));
                     let d = v.dimension;
@@ -1224,8 +1312,9 @@ fn invalid(message: String) -> io::Error {
     io::Error::new(io::ErrorKind::InvalidInput, message)
 }
 
-/// A primitive to write: its material label and its faces.
-type Primitive = (u32, Vec<usize>);
+/// A primitive to write: its material label, which written channels it has, and its
+/// faces.
+type Primitive = (u32, Vec<bool>, Vec<usize>);
 
 /// Writes `mesh` as glTF JSON with an embedded buffer, or as GLB.
 pub(crate) fn write<W: Write>(out: &mut W, mesh: &IndexedMesh, format: Format) -> io::Result<()> {
@@ -1289,30 +1378,38 @@ pub(crate) fn write<W: Write>(out: &mut W, mesh: &IndexedMesh, format: Format) -
             let a = b.add(floats(values), count, kind, FLOAT, ARRAY_BUFFER, None);
             attributes.push((semantic, a));
         }
-        // Faces by group (one glTF mesh each) and within a group by material (one
-        // primitive each), both in order of first appearance.
+        // Faces by group (one glTF mesh each) and within a group by material and by
+        // the channels they have (one primitive each), all in order of first
+        // appearance. A glTF attribute belongs to a whole primitive: faces with a
+        // channel and faces without it (two primitives of one material in the file
+        // read) need primitives of their own, or the second would read back with the
+        // zeros the shared accessor holds for them rather than with no value.
         let label = |l: &FaceLabels, t: usize| l.faces.get(t).copied().unwrap_or(FaceLabels::NONE);
         let (materials, groups) = (&mesh.attributes.materials, &mesh.attributes.groups);
         let mut meshes: Vec<(u32, Vec<Primitive>)> = Vec::new();
         let mut mesh_of: HashMap<u32, usize> = HashMap::new();
-        let mut primitive_of: HashMap<(u32, u32), usize> = HashMap::new();
+        let mut primitive_of: HashMap<(u32, u32, Vec<bool>), usize> = HashMap::new();
         for t in 0..pv.triangles.len() {
             let (g, m) = (label(groups, t), label(materials, t));
+            let has: Vec<bool> = written
+                .iter()
+                .map(|c| c.corners[t].iter().any(|&i| i != Channel::MISSING))
+                .collect();
             let gi = *mesh_of.entry(g).or_insert_with(|| {
                 meshes.push((g, Vec::new()));
                 meshes.len() - 1
             });
             let prims = &mut meshes[gi].1;
-            let pi = *primitive_of.entry((g, m)).or_insert_with(|| {
-                prims.push((m, Vec::new()));
+            let pi = *primitive_of.entry((g, m, has.clone())).or_insert_with(|| {
+                prims.push((m, has, Vec::new()));
                 prims.len() - 1
             });
-            prims[pi].1.push(t);
+            prims[pi].2.push(t);
         }
         let mut json_meshes = Vec::new();
         for (g, prims) in &meshes {
             let mut primitives = Vec::new();
-            for (m, faces) in prims {
+            for (m, has, faces) in prims {
                 let indices = faces
                     .iter()
                     .flat_map(|&t| pv.triangles[t])
@@ -1331,11 +1428,8 @@ pub(crate) fn write<W: Write>(out: &mut W, mesh: &IndexedMesh, format: Format) -
                 // reading gives those corners no value again (rather than zeros).
                 let mut used = serde_json::Map::new();
                 used.insert("POSITION".into(), position.into());
-                for ((semantic, a), c) in attributes.iter().zip(&written) {
-                    let has = |t: &usize| c.corners[*t].iter().any(|&i| i != Channel::MISSING);
-                    if faces.iter().any(has) {
-                        used.insert(semantic.to_string(), (*a).into());
-                    }
+                for ((semantic, a), _) in attributes.iter().zip(has).filter(|(_, &h)| h) {
+                    used.insert(semantic.to_string(), (*a).into());
                 }
                 let mut p = serde_json::json!({
                     "attributes": used,
@@ -1422,6 +1516,12 @@ mod tests {
         assert_eq!(encode_base64(b"Man"), "TWFu");
         assert_eq!(decode_base64(b"TWE"), Some(b"Ma".to_vec()));
         assert_eq!(decode_base64(b"TW!u"), None);
+        for text in [
+            "", "T", "TW", "TWE", "TWFu", "TWFuTQ", "TWFuTQ==", "TWFuTWE=",
+        ] {
+            let decoded = decode_base64(text.as_bytes()).unwrap();
+            assert_eq!(decoded_len(text.as_bytes()), decoded.len(), "{text}");
+        }
     }
 
     #[test]

@@ -395,26 +395,19 @@ pub fn read_path(path: &Path) -> Result<LoadedMesh, IoError> {
         source,
     })?;
     let dir = path.parent().unwrap_or(Path::new("."));
-    let open = |uri: &str, len: usize| read_buffer_file(&dir.join(uri), uri, len);
+    let open = |uri: &str, len: usize| read_buffer_file(&dir.join(uri), len);
     read_with(&bytes, format, Some(&open)).map_err(read_err)
 }
 
-/// The first `len` bytes of a glTF buffer file (`uri` as the glTF names it); fewer
-/// when the file is shorter, which the caller reports. Reading stops at `len`, so a
-/// large file is not read whole.
-fn read_buffer_file(path: &Path, uri: &str, len: usize) -> Result<Vec<u8>, ReadError> {
-    let fail = |e: std::io::Error| {
-        ReadError::new(
-            ReadErrorKind::BufferFile {
-                uri: uri.to_string(),
-                detail: e.to_string(),
-            },
-            None,
-        )
-    };
-    let file = std::fs::File::open(path).map_err(fail)?;
+/// The first `len` bytes of a glTF buffer file; fewer when the file is shorter, which
+/// the caller reports (it also names the buffer in errors). Reading stops at `len`, so
+/// a large file is not read whole, and nothing is reserved for `len` up front, so a
+/// buffer that declares more than its file holds costs only what the file holds.
+fn read_buffer_file(path: &Path, len: usize) -> std::io::Result<Vec<u8>> {
     let mut data = Vec::new();
-    file.take(len as u64).read_to_end(&mut data).map_err(fail)?;
+    std::fs::File::open(path)?
+        .take(len as u64)
+        .read_to_end(&mut data)?;
     Ok(data)
 }
 

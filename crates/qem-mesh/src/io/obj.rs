@@ -5,7 +5,9 @@
 //! ([`crate::attributes`]): texture coordinates (`vt`) and normals (`vn`) per corner,
 //! each face's group (`o`/`g`) and material (`usemtl`), and the material files
 //! (`mtllib`, not opened), and vertex colours (`v x y z r g b`, read as 0–1; a file
-//! with a value above 1 is read as 0–255 levels). A corner without a `vt` or `vn` index has none
+//! with a value above 1 is read as 0–255 levels; a component still outside 0–1 is
+//! clamped, since no OBJ file could hold it: written back, a value above 1 would make
+//! every colour a level). A corner without a `vt` or `vn` index has none
 //! ([`Channel::MISSING`]): `tobj` would fill it with a neighbour's value, so the reader
 //! marks those corners from its own scan. `l` and `p` elements, points and lines
 //! written as `f` with one or two corners, and smoothing groups are ignored. Polygons
@@ -15,7 +17,10 @@
 //! The writer writes all of it: `mtllib`, `v` (with its colour; a vertex with colour
 //! seams once per colour, which an exact weld joins again), `vt`, `vn`, then the faces as
 //! `v/vt/vn` corners with a `g` or `usemtl` line wherever the group or material
-//! changes (the first channel of each kind: OBJ has one slot each).
+//! changes (the first channel of each kind: OBJ has one slot each). Names are written
+//! byte for byte, except that a line feed becomes a space and a name ending in a
+//! backslash is followed by a space (which the reader trims), so that it does not
+//! continue its line.
 //!
 //! `tobj` splits the file into one model per `o`/`g`/`usemtl` section and numbers each
 //! model's vertices in the order its faces first use them. The reader concatenates the
@@ -31,9 +36,11 @@
 //! "absent"). So the reader first scans the bytes itself and reports, with the line:
 //! bytes that are not UTF-8 on a `v`, `vt`, `vn`, `f` or `l` line, `v` lines without
 //! three numbers or with a non-finite coordinate or a zero `w`, `vt` and `vn` lines
-//! without enough numbers, and every face index that is not an integer, is 0, points
-//! before the first element or past the last one of its list. Whatever `tobj` still
-//! refuses is reported with its own message and no line.
+//! without enough numbers, a texture coordinate, normal or vertex colour that is not a
+//! finite 32-bit float (NaN, or beyond float32: attributes are kept as `f32`), and
+//! every face index that is not an integer, is 0, points before the first element or
+//! past the last one of its list. Whatever `tobj` still refuses is reported with its
+//! own message and no line.
 //!
 //! # Lenient where the geometry is not at stake
 //! Everything else may hold any bytes: comments, names and unknown lines. `tobj` reads
@@ -160,6 +167,13 @@ impl Slots {
             }
             return;
         }
+        // A mixed face lies in a run where every corner has both, and only its own
+        // corners without one are marked. The run must start at this face: the run
+        // before it (say, faces without `vn`) would otherwise cover it and mark its
+        // corners that have one as missing too.
+        if self.runs.last().is_none_or(|r| (r.1, r.2) != (true, true)) {
+            self.runs.push((first, true, true));
+        }
         // Fan triangulation: triangle j of the face has corners 0, j + 1, j + 2.
         let corners: Vec<(bool, bool)> = words(rest).map(corner_slots).collect();
         for j in 0..corners.len().saturating_sub(2) {
@@ -167,9 +181,6 @@ impl Slots {
                 self.mixed.push((first + j, k, corners[c].0, corners[c].1));
             }
         }
-        // The run after a mixed face starts fresh.
-        self.runs
-            .push((first + corners.len().saturating_sub(2), true, true));
     }
 
     /// Marks the corners without an index as missing in `uv` and `normal`.
@@ -345,7 +356,8 @@ fn prescan(bytes: &[u8], detailed: bool) -> Result<Scan, ReadError> {
                 let first = extra.next();
                 let n_extra = usize::from(first.is_some()) + extra.count();
                 match (n_extra, first) {
-                    (0 | 3, _) => {}
+                    (0, _) => {}
+                    (3, _) => check_f32(words(rest).skip(3), at, || format!("vertex {v}: colour"))?,
                     (_, Some(w)) if n_extra == 1 => {
                         if parse_f64(w).is_none_or(|w| w == 0.0 || !w.is_finite()) {
                             return Err(ReadError::malformed(
@@ -368,11 +380,17 @@ fn prescan(bytes: &[u8], detailed: bool) -> Result<Scan, ReadError> {
                 so_far.v += 1;
             }
             b"vt" => {
-                numbers(2, "texture coordinate", so_far.vt)?;
+                let index = so_far.vt;
+                numbers(2, "texture coordinate", index)?;
+                check_f32(words(rest).take(2), at, || {
+                    format!("texture coordinate {index}")
+                })?;
                 so_far.vt += 1;
             }
             b"vn" => {
-                numbers(3, "normal", so_far.vn)?;
+                let index = so_far.vn;
+                numbers(3, "normal", index)?;
+                check_f32(words(rest).take(3), at, || format!("normal {index}"))?;
                 so_far.vn += 1;
             }
             b"f" | b"l" => {
@@ -430,6 +448,26 @@ fn prescan(bytes: &[u8], detailed: bool) -> Result<Scan, ReadError> {
         }
     }
     Ok(scan)
+}
+
+/// Refuses the first of `tokens` (numbers, already checked) that is not a finite
+/// `f32`: texture coordinates, normals and colours are kept as `f32`, so a NaN, an
+/// infinity or a value beyond float32 (`1e39`) would be refused by the mesh's
+/// validation, which cannot name the line. `what` names the element for the message.
+fn check_f32<'a>(
+    tokens: impl Iterator<Item = &'a [u8]>,
+    at: Location,
+    what: impl Fn() -> String,
+) -> Result<(), ReadError> {
+    for tok in tokens {
+        if parse_f64(tok).is_some_and(|x| !(x as f32).is_finite()) {
+            return Err(ReadError::malformed(
+                at,
+                format!("{}: {} is not a finite 32-bit float", what(), show(tok)),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Whether a face line's corners are all `a[/[b][/c]]` with positive indices of at
@@ -719,9 +757,7 @@ fn assemble(models: &[tobj::Model]) -> IndexedMesh {
     }
     if colours {
         // Some exporters write 0–255 levels: a value above 1 says so.
-        if colour.iter().any(|&c| c > 1.0) {
-            colour.iter_mut().for_each(|c| *c /= 255.0);
-        }
+        super::channels::unit_colours(&mut colour);
         let corners = mesh.triangles.clone();
         mesh.attributes
             .channels
@@ -738,6 +774,24 @@ fn push_corners(dst: &mut Vec<[u32; 3]>, src: &[u32], base: u32, ntri: usize) {
         let corner = |k: usize| src.get(3 * t + k).map_or(miss, |&i| base + i);
         dst.push([corner(0), corner(1), corner(2)]);
     }
+}
+
+/// Writes a name (group, material, material library) as the reader will read it back,
+/// byte for byte where OBJ can hold it: a line feed (a glTF name may have one) becomes
+/// a space, and a name that ends in a backslash (or a carriage return) gets a space
+/// after it, which the reader trims, since a backslash before the line break would
+/// continue the line (a fuzzed `g seg \\` took the next `f` line into the name).
+fn write_name(out: &mut impl Write, name: &[u8]) -> std::io::Result<()> {
+    for (k, line) in name.split(|&b| b == b'\n').enumerate() {
+        if k > 0 {
+            out.write_all(b" ")?;
+        }
+        out.write_all(line)?;
+    }
+    if name.ends_with(b"\\") || name.ends_with(b"\r") {
+        out.write_all(b" ")?;
+    }
+    Ok(())
 }
 
 pub(crate) fn write(
@@ -777,7 +831,7 @@ pub(crate) fn write(
     )?;
     for library in &attrs.material_libraries {
         out.write_all(b"mtllib ")?;
-        out.write_all(library)?;
+        write_name(out, library)?;
         out.write_all(b"\n")?;
     }
     for (v, [x, y, z]) in positions.iter().enumerate() {
@@ -818,7 +872,7 @@ pub(crate) fn write(
                 out.write_all(keyword)?;
                 if let Some(name) = labels.names.get(label as usize) {
                     out.write_all(b" ")?;
-                    out.write_all(name)?;
+                    write_name(out, name)?;
                 }
                 out.write_all(b"\n")?;
             }

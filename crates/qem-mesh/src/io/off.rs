@@ -20,7 +20,9 @@
 //! exporters). The reader decides per channel: if any component is above 1, all are
 //! 0–255 levels and divided by 255; otherwise they are taken as 0–1 floats. Whether a
 //! number is written as an integer decides nothing, since floats such as 1 and 0 are
-//! written that way too.
+//! written that way too. A component still outside 0–1 (a level above 255, a negative
+//! number) is clamped to it, as the writer would: the file's colours then survive a
+//! round trip.
 //!
 //! Comments may hold any bytes (they are counted in [`ReadNotes::non_utf8_lines`] when
 //! they are not UTF-8); numbers must be numbers. Lines after the last face are skipped
@@ -41,7 +43,7 @@ use std::io::Write;
 
 use smallvec::SmallVec;
 
-use super::channels::{from_level, is_face_colour, per_vertex};
+use super::channels::{colours_on_faces, per_vertex, unit_colours};
 use super::text::{self, capacity_for, parse_f32, parse_f64, parse_i64, show, words};
 use super::{sniff, Format, Location, ReadError, ReadNotes};
 use crate::attributes::{Attributes, Channel, ChannelKind};
@@ -346,17 +348,10 @@ fn attribute(tok: &[u8], item: &str, what: &str, at: Location) -> Result<f32, Re
     Ok(v)
 }
 
-/// A channel's colours in 0–1. OFF does not say whether colours are 0–255 integers
-/// (common in practice) or 0–1 floats (Geomview's spec): they are integer levels when
-/// any component is above 1, since 0–1 colours never are, and floats otherwise. A
-/// file's colours either all are levels or none is, so one dark colour cannot be read
-/// differently from the others.
+/// A channel's colours in 0–1 ([`unit_colours`]). OFF does not say whether colours
+/// are 0–255 integers (common in practice) or 0–1 floats (Geomview's spec).
 fn levels(mut colours: Vec<f32>) -> Vec<f32> {
-    if colours.iter().any(|&c| c > 1.0) {
-        for c in &mut colours {
-            *c = from_level(f64::from(*c), 255.0);
-        }
-    }
+    unit_colours(&mut colours);
     colours
 }
 
@@ -379,27 +374,25 @@ pub(crate) enum Slot {
 
 /// Where [`write`] puts each of `channels`: the first normals, the first colour that
 /// is not per face and the first texture coordinates on the vertices (NOFF, COFF,
-/// STOFF), the first colour with one value per triangle on the faces; nothing else
-/// has a place in OFF.
+/// STOFF), the first colour with one value per triangle on the faces (see
+/// [`colours_on_faces`] for two of them); nothing else has a place in OFF.
 pub(crate) fn slots(channels: &[Channel]) -> Vec<Slot> {
     let mut taken: Vec<(ChannelKind, bool)> = Vec::new();
     channels
         .iter()
-        .map(|c| {
-            let on_face = is_face_colour(c);
-            match c.kind {
-                ChannelKind::Generic => Slot::Left("OFF holds no generic channels"),
-                _ if !taken.contains(&(c.kind, on_face)) => {
-                    taken.push((c.kind, on_face));
-                    if on_face {
-                        Slot::Face
-                    } else {
-                        Slot::Vertex
-                    }
+        .zip(colours_on_faces(channels))
+        .map(|(c, on_face)| match c.kind {
+            ChannelKind::Generic => Slot::Left("OFF holds no generic channels"),
+            _ if !taken.contains(&(c.kind, on_face)) => {
+                taken.push((c.kind, on_face));
+                if on_face {
+                    Slot::Face
+                } else {
+                    Slot::Vertex
                 }
-                ChannelKind::Color => Slot::Left("OFF holds one vertex colour and one face colour"),
-                _ => Slot::Left("OFF holds one texture coordinate and one normal per vertex"),
             }
+            ChannelKind::Color => Slot::Left("OFF holds one vertex colour and one face colour"),
+            _ => Slot::Left("OFF holds one texture coordinate and one normal per vertex"),
         })
         .collect()
 }

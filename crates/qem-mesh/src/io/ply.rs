@@ -16,7 +16,8 @@
 //! - texture coordinates `s t`, `u v`, `texture_u texture_v` or `texture_s texture_t`;
 //! - every other scalar: a [`ChannelKind::Generic`] channel named after the property,
 //!   and `<name>_0`, `<name>_1`... (2 to 4 in a row) as one vector channel `<name>`.
-//!   Integers become floats (exact up to 2^24).
+//!   Integers become floats (exact up to 2^24). A name that no PLY file could hold
+//!   (empty, or with a space or control byte) is skipped, as the writer leaves it out.
 //!
 //! Only the first complete set of each kind is read; a property named like a member of
 //! a set (`red`, `u`, ...) outside a complete set is skipped. The face element's
@@ -54,7 +55,7 @@
 
 use std::io::Write;
 
-use super::channels::{all_levels, from_level, is_face_colour, per_vertex, to_level};
+use super::channels::{all_levels, colours_on_faces, from_level, per_vertex, to_level};
 use super::off::fan;
 use super::text::{self, capacity_for, parse_f32, parse_f64, parse_i64, show, Tokens};
 use super::{sniff, Format, Location, ReadError, ReadNotes};
@@ -302,6 +303,25 @@ fn is_reserved(name: &[u8]) -> bool {
     matches!(name, b"x" | b"y" | b"z") || VERTEX_SETS.iter().any(|(_, set)| set.contains(&name))
 }
 
+/// The PLY property names of a generic channel: its name, or `<name>_0`, `<name>_1`...
+/// for a vector. The writer writes them; the reader skips a channel whose names an
+/// earlier one has, which the writer could not write.
+fn generic_property_names(name: &str, dimension: usize) -> Vec<String> {
+    if dimension == 1 {
+        vec![name.to_string()]
+    } else {
+        (0..dimension).map(|k| format!("{name}_{k}")).collect()
+    }
+}
+
+/// Whether a generic channel's name can be a PLY property name: not empty, and without
+/// spaces or control bytes (which PLY readers take for a separator or choke on). The
+/// writer leaves other channels out; the reader skips such properties (a fuzzed
+/// header had `diff&use\0\x0b_red`), so that what it reads it can write back.
+fn is_writable_name(name: &[u8]) -> bool {
+    !name.is_empty() && !name.iter().any(|&b| b <= b' ' || b == 0x7f)
+}
+
 /// How a property's number becomes a channel's float.
 #[derive(Clone, Copy, Debug)]
 enum Convert {
@@ -460,7 +480,12 @@ fn plan(el: &Element, side: Side, names: &mut Vec<String>) -> Result<Plan, ReadE
         // Every other scalar: a generic channel; `<base>_0`, `<base>_1`... (2 to 4 in a
         // row) together, as the writer writes a generic vector.
         let free = |i: usize| {
-            scalar(i) && !member[i] && !is_reserved(el.props[i].0) && matches!(roles[i], Role::Skip)
+            let name = el.props[i].0;
+            scalar(i)
+                && !member[i]
+                && !is_reserved(name)
+                && is_writable_name(name)
+                && matches!(roles[i], Role::Skip)
         };
         let mut i = 0;
         while i < el.props.len() {
@@ -484,6 +509,11 @@ fn plan(el: &Element, side: Side, names: &mut Vec<String>) -> Result<Plan, ReadE
             } else {
                 name
             };
+            // `_0`, `_1`: a vector without a name.
+            if !is_writable_name(shown) {
+                i += len;
+                continue;
+            }
             candidates.push((
                 ChannelKind::Generic,
                 String::from_utf8_lossy(shown).into_owned(),
@@ -495,9 +525,21 @@ fn plan(el: &Element, side: Side, names: &mut Vec<String>) -> Result<Plan, ReadE
 
     // Accepted in priority order (sets, then generics), kept in property order.
     let mut accepted = Vec::new();
+    // The property names of the generic channels accepted, as the writer names them.
+    let mut written: Vec<String> = Vec::new();
     for (kind, name, members) in candidates {
         if names.len() >= MAX_CHANNELS || names.contains(&name) {
             continue;
+        }
+        if kind == ChannelKind::Generic {
+            // A channel whose property names another has could not be written back
+            // (`a_0 a_1` and a second `a_0`; or two names that differ only in bytes
+            // that are not UTF-8, which both become U+FFFD), so it is skipped.
+            let props = generic_property_names(&name, members.len());
+            if props.iter().any(|p| written.contains(p)) {
+                continue;
+            }
+            written.extend(props);
         }
         names.push(name.clone());
         accepted.push((kind, name, members));
@@ -1119,8 +1161,9 @@ pub(crate) enum Placement {
 
 /// Where [`write`] puts each of `channels`: the first texture coordinates as `s t`, the
 /// first normals as `nx ny nz`, the first colour with one value per triangle as the
-/// faces' `red green blue [alpha]` and the first other colour as the vertices',
-/// generic channels under their names (`<name>_0`, `<name>_1`... for vectors), at most
+/// faces' `red green blue [alpha]` and the first other colour as the vertices' (of two
+/// colours that both have one value per triangle, the first goes on the vertices:
+/// `channels::colours_on_faces`), generic channels under their names (`<name>_0`, `<name>_1`... for vectors), at most
 /// [`MAX_CHANNELS`] in all (what the reader reads back).
 pub(crate) fn placements(channels: &[Channel]) -> Vec<Placement> {
     let mut used: Vec<String> = Vec::new();
@@ -1134,8 +1177,8 @@ pub(crate) fn placements(channels: &[Channel]) -> Vec<Placement> {
     };
     channels
         .iter()
-        .map(|c| {
-            let on_face = is_face_colour(c);
+        .zip(colours_on_faces(channels))
+        .map(|(c, on_face)| {
             let taken = kinds.contains(&(c.kind, on_face));
             let placement = match c.kind {
                 _ if count >= MAX_CHANNELS => {
@@ -1154,14 +1197,8 @@ pub(crate) fn placements(channels: &[Channel]) -> Vec<Placement> {
                 ChannelKind::Color if on_face => Placement::Face(colour(c.dimension)),
                 ChannelKind::Color => Placement::Vertex(colour(c.dimension)),
                 ChannelKind::Generic => {
-                    let names: Vec<String> = if c.dimension == 1 {
-                        vec![c.name.clone()]
-                    } else {
-                        (0..c.dimension)
-                            .map(|k| format!("{}_{k}", c.name))
-                            .collect()
-                    };
-                    if c.name.is_empty() || c.name.bytes().any(|b| b <= b' ' || b == 0x7f) {
+                    let names = generic_property_names(&c.name, c.dimension);
+                    if !is_writable_name(c.name.as_bytes()) {
                         Placement::Left("a PLY property name cannot be empty or hold spaces")
                     } else if names.iter().any(|n| is_reserved(n.as_bytes())) {
                         Placement::Left("PLY readers give this property name another meaning")

@@ -14,27 +14,7 @@ use qem_mesh::io::{read_bytes, read_path, unwritable, write_path, Format};
 use qem_mesh::IndexedMesh;
 use serde_json::{json, Value};
 
-use crate::attributes_common::{encode, err, load};
-
-/// A GLB file from a JSON document and a BIN chunk.
-fn glb(doc: &Value, bin: &[u8]) -> Vec<u8> {
-    let mut json_text = serde_json::to_vec(doc).unwrap();
-    json_text.resize(json_text.len().next_multiple_of(4), b' ');
-    let mut bin = bin.to_vec();
-    bin.resize(bin.len().next_multiple_of(4), 0);
-    let total = 12 + 8 + json_text.len() + 8 + bin.len();
-    let mut out = Vec::new();
-    out.extend_from_slice(b"glTF");
-    out.extend_from_slice(&2u32.to_le_bytes());
-    out.extend_from_slice(&(total as u32).to_le_bytes());
-    out.extend_from_slice(&(json_text.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"JSON");
-    out.extend_from_slice(&json_text);
-    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"BIN\0");
-    out.extend_from_slice(&bin);
-    out
-}
+use crate::attributes_common::{encode, err, glb, load};
 
 fn floats(values: &[f32]) -> Vec<u8> {
     values.iter().flat_map(|v| v.to_le_bytes()).collect()
@@ -368,7 +348,7 @@ fn external_buffers_resolve_beside_the_file_but_not_from_memory() {
     std::fs::remove_file(dir.path().join("data file.bin")).unwrap();
     let e = read_path(&path).unwrap_err().to_string();
     assert!(
-        e.contains("buffer file \"data file.bin\": cannot read"),
+        e.contains("buffer 0: cannot read its file \"data file.bin\""),
         "{e}"
     );
     // Absolute paths and URLs are refused.

@@ -22,6 +22,8 @@ mod bvh_extremes;
 mod cluster;
 mod exact_quadrics;
 #[cfg(feature = "io")]
+mod hostile_attributes;
+#[cfg(feature = "io")]
 mod io_corpus;
 #[cfg(feature = "io")]
 mod io_errors;
