@@ -43,7 +43,7 @@ pub fn read_gltf(data: &[u8]) {
 ///
 /// A mesh that was read is written back in the same format (STL and glTF refuse
 /// coordinates beyond float32, the one accepted write error) and read again, and must
-/// come back as the same triangles with the same attributes ([`Face`]):
+/// come back as the same triangles with the same attributes (`Face`):
 /// - OBJ, PLY and OFF: the same indices and position bits, and face by face the same
 ///   channel values at each corner, material and group; OBJ also the same material
 ///   libraries;
