@@ -1,7 +1,9 @@
 //! Named regression tests for the fuzz findings recorded in FUZZING.md, stated as
 //! scenarios (the raw reproducers are replayed by `fuzz_replay.rs`).
 
+use qem_mesh::attributes::ChannelKind;
 use qem_mesh::clean::CleanOptions;
+use qem_mesh::io::{read_bytes, write_to, Format, LoadedMesh};
 use qem_mesh::pairs::{virtual_pairs, GridOptions};
 use qem_mesh::simplify::{
     simplify, simplify_observed, ContractionOrder, Length, SimplifyError, SimplifyOptions,
@@ -172,23 +174,31 @@ fn stl_output_refuses_coordinates_beyond_float32() {
     qem_mesh::io::write_to(&mut bytes, &edge, qem_mesh::io::Format::Stl).expect("fits");
 }
 
-/// A read_gltf reproducer (`fuzz/regressions/read_gltf/NAME`), read as glTF, and the same
-/// mesh after a trip through GLB.
-fn gltf_round_trip(name: &str) -> (IndexedMesh, IndexedMesh) {
-    use qem_mesh::io::{read_bytes, write_to, Format};
+/// The reproducer `fuzz/regressions/TARGET/NAME` (the reader findings of issue 29).
+fn reproducer(target: &str, name: &str) -> Vec<u8> {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../fuzz/regressions/read_gltf")
+        .join("../fuzz/regressions")
+        .join(target)
         .join(name);
-    let data = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let read = |bytes: &[u8], format| {
-        read_bytes(bytes, format)
-            .unwrap_or_else(|e| panic!("{name}: refused: {e}"))
-            .mesh
-    };
-    let first = read(&data, Format::Gltf);
-    let mut glb = Vec::new();
-    write_to(&mut glb, &first, Format::Glb).unwrap_or_else(|e| panic!("{name}: {e}"));
-    let again = read(&glb, Format::Glb);
+    std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// `bytes` read in `format`; panics with the reader's message when refused.
+fn loaded(bytes: &[u8], format: Format) -> LoadedMesh {
+    read_bytes(bytes, format).unwrap_or_else(|e| panic!("{format:?}: refused: {e}"))
+}
+
+/// `mesh` written in `format` and read again.
+fn round_trip(mesh: &IndexedMesh, format: Format) -> IndexedMesh {
+    let mut written = Vec::new();
+    write_to(&mut written, mesh, format).unwrap_or_else(|e| panic!("{format:?}: {e}"));
+    loaded(&written, format).mesh
+}
+
+/// A read_gltf reproducer read as glTF, and the same mesh after a trip through GLB.
+fn gltf_round_trip(name: &str) -> (IndexedMesh, IndexedMesh) {
+    let first = loaded(&reproducer("read_gltf", name), Format::Gltf).mesh;
+    let again = round_trip(&first, Format::Glb);
     (first, again)
 }
 
@@ -256,25 +266,9 @@ fn an_attribute_only_a_primitive_without_triangles_has_makes_no_channel() {
     assert_eq!(channel_names(&again), ["uv"]);
 }
 
-/// The colours of `name`'s first vertex (a `fuzz/regressions/TARGET` reproducer), read
-/// in `format`, and after a trip through the same format.
-fn first_colour_round_trip(
-    target: &str,
-    name: &str,
-    format: qem_mesh::io::Format,
-) -> (Vec<f32>, Vec<f32>) {
-    use qem_mesh::attributes::ChannelKind;
-    use qem_mesh::io::{read_bytes, write_to};
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../fuzz/regressions")
-        .join(target)
-        .join(name);
-    let data = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let read = |bytes: &[u8]| {
-        read_bytes(bytes, format)
-            .unwrap_or_else(|e| panic!("{name}: refused: {e}"))
-            .mesh
-    };
+/// The colour at the first corner of reproducer `target/name` read in `format`, and
+/// after a trip through the same format.
+fn first_colour_round_trip(target: &str, name: &str, format: Format) -> (Vec<f32>, Vec<f32>) {
     let colour = |mesh: &IndexedMesh| -> Vec<f32> {
         let channel = mesh.attributes.channel(ChannelKind::Color);
         channel
@@ -282,10 +276,8 @@ fn first_colour_round_trip(
             .unwrap_or_default()
             .to_vec()
     };
-    let first = read(&data);
-    let mut written = Vec::new();
-    write_to(&mut written, &first, format).unwrap_or_else(|e| panic!("{name}: {e}"));
-    (colour(&first), colour(&read(&written)))
+    let first = loaded(&reproducer(target, name), format).mesh;
+    (colour(&first), colour(&round_trip(&first, format)))
 }
 
 /// read_obj finding 15 (`colour_level_above_255`, found by the attribute round trip
@@ -295,11 +287,7 @@ fn first_colour_round_trip(
 /// after the rule, in OBJ and OFF.
 #[test]
 fn an_obj_colour_level_above_255_is_clamped_and_survives_a_round_trip() {
-    let (first, again) = first_colour_round_trip(
-        "read_obj",
-        "colour_level_above_255",
-        qem_mesh::io::Format::Obj,
-    );
+    let (first, again) = first_colour_round_trip("read_obj", "colour_level_above_255", Format::Obj);
     assert_eq!(first, [1.0, 0.0, 0.0]);
     assert_eq!(again, first);
 }
@@ -309,8 +297,7 @@ fn an_obj_colour_level_above_255_is_clamped_and_survives_a_round_trip() {
 /// colours to 0–1, wrote 0. The reader now clamps too.
 #[test]
 fn a_negative_off_colour_is_clamped_and_survives_a_round_trip() {
-    let (first, again) =
-        first_colour_round_trip("read_off", "negative_colour", qem_mesh::io::Format::Off);
+    let (first, again) = first_colour_round_trip("read_off", "negative_colour", Format::Off);
     assert_eq!(first, [0.0, 0.0, 0.0]);
     assert_eq!(again, first);
 }
@@ -323,14 +310,8 @@ fn a_negative_off_colour_is_clamped_and_survives_a_round_trip() {
 /// first reading of such a file lost them as well.
 #[test]
 fn a_mixed_face_after_faces_without_normals_keeps_its_normals() {
-    use qem_mesh::attributes::ChannelKind;
-    use qem_mesh::io::{read_bytes, Format};
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../fuzz/regressions/read_obj/mixed_face_after_a_face_without_vn");
-    let data = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mesh = read_bytes(&data, Format::Obj)
-        .unwrap_or_else(|e| panic!("refused: {e}"))
-        .mesh;
+    let data = reproducer("read_obj", "mixed_face_after_a_face_without_vn");
+    let mesh = loaded(&data, Format::Obj).mesh;
     let normal = mesh
         .attributes
         .channel(ChannelKind::Normal)
@@ -346,15 +327,10 @@ fn a_mixed_face_after_faces_without_normals_keeps_its_normals() {
 /// writer then left out, so a round trip lost them. The reader now skips them too.
 #[test]
 fn ply_properties_the_writer_cannot_name_are_skipped() {
-    use qem_mesh::io::{read_bytes, Format};
     for name in ["control_byte_in_property_name", "vector_without_a_name"] {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../fuzz/regressions/read_ply")
-            .join(name);
-        let data = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        let loaded = read_bytes(&data, Format::Ply).unwrap_or_else(|e| panic!("{name}: {e}"));
-        assert!(loaded.mesh.attributes.channels.is_empty(), "{name}");
-        assert!(loaded.notes.skipped_properties > 0, "{name}");
+        let read = loaded(&reproducer("read_ply", name), Format::Ply);
+        assert!(read.mesh.attributes.channels.is_empty(), "{name}");
+        assert!(read.notes.skipped_properties > 0, "{name}");
     }
 }
 
@@ -365,23 +341,16 @@ fn ply_properties_the_writer_cannot_name_are_skipped() {
 /// now puts a space after such a name.
 #[test]
 fn obj_names_ending_in_a_backslash_survive_a_round_trip() {
-    use qem_mesh::io::{read_bytes, write_to, Format};
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../fuzz/regressions/read_obj/names_ending_in_a_backslash");
-    let data = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let read = |bytes: &[u8]| {
-        read_bytes(bytes, Format::Obj)
-            .unwrap_or_else(|e| panic!("refused: {e}"))
-            .mesh
-    };
-    let first = read(&data);
+    let first = loaded(
+        &reproducer("read_obj", "names_ending_in_a_backslash"),
+        Format::Obj,
+    )
+    .mesh;
     let names = &first.attributes;
     assert_eq!(names.groups.names, [b"seg \\".to_vec()]);
     assert_eq!(names.materials.names, [b"red\\\\".to_vec()]);
     assert_eq!(names.material_libraries, [b"lib\\".to_vec()]);
-    let mut written = Vec::new();
-    write_to(&mut written, &first, Format::Obj).unwrap_or_else(|e| panic!("{e}"));
-    assert_eq!(read(&written), first);
+    assert_eq!(round_trip(&first, Format::Obj), first);
 }
 
 /// read_ply finding 20 (`property_names_*twice*`): `flow_0 flow_1` and a second
@@ -391,18 +360,15 @@ fn obj_names_ending_in_a_backslash_survive_a_round_trip() {
 /// channel whose property names an earlier one has.
 #[test]
 fn a_ply_property_name_two_channels_would_write_is_read_once() {
-    use qem_mesh::io::{read_bytes, Format};
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../fuzz/regressions/read_ply/property_names_of_a_vector_twice");
-    let data = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let loaded = read_bytes(&data, Format::Ply).unwrap_or_else(|e| panic!("{e}"));
-    let channels = &loaded.mesh.attributes.channels;
+    let data = reproducer("read_ply", "property_names_of_a_vector_twice");
+    let read = loaded(&data, Format::Ply);
+    let channels = &read.mesh.attributes.channels;
     let names: Vec<(&str, usize)> = channels
         .iter()
         .map(|c| (c.name.as_str(), c.dimension))
         .collect();
     assert_eq!(names, [("flow", 2)]);
-    assert_eq!(loaded.notes.skipped_properties, 1);
+    assert_eq!(read.notes.skipped_properties, 1);
 }
 
 /// read_off finding 21 (`vertex_and_face_colour_on_a_degenerate_face`, also in PLY):
@@ -412,22 +378,10 @@ fn a_ply_property_name_two_channels_would_write_is_read_once() {
 /// vertices, where the readers' vertex colour came from.
 #[test]
 fn a_vertex_and_a_face_colour_on_degenerate_faces_both_survive() {
-    use qem_mesh::io::{read_bytes, write_to, Format};
     for (target, format) in [("read_off", Format::Off), ("read_ply", Format::Ply)] {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../fuzz/regressions")
-            .join(target)
-            .join("vertex_and_face_colour_on_a_degenerate_face");
-        let data = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        let read = |bytes: &[u8]| {
-            read_bytes(bytes, format)
-                .unwrap_or_else(|e| panic!("{target}: refused: {e}"))
-                .mesh
-        };
-        let first = read(&data);
+        let data = reproducer(target, "vertex_and_face_colour_on_a_degenerate_face");
+        let first = loaded(&data, format).mesh;
         assert_eq!(channel_names(&first), ["colour", "face_colour"], "{target}");
-        let mut written = Vec::new();
-        write_to(&mut written, &first, format).unwrap_or_else(|e| panic!("{e}"));
-        assert_eq!(read(&written), first, "{target}");
+        assert_eq!(round_trip(&first, format), first, "{target}");
     }
 }
