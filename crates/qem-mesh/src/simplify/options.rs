@@ -170,8 +170,9 @@ pub enum ContractionOrder {
     /// 40 messy corpus meshes the same (geometric means of 80 runs, Hausdorff distance
     /// 1.000x, mean distance 1.010x). A pair the orientation check refuses is ranked at
     /// the waivers' penalty in later passes and tried without the check next time,
-    /// unless one of its ends moves first. With a [`max_error`](SimplifyOptions::max_error) bound, a pair over the
-    /// bound is never contracted but does not end the run either; the run stops with
+    /// unless one of its ends moves first. With a
+    /// [`max_error`](SimplifyOptions::max_error) bound, a pair over the bound is never
+    /// contracted but does not end the run either; the run stops with
     /// [`StopReason::MaxErrorReached`](super::StopReason::MaxErrorReached) when a pass
     /// contracts nothing and met at least one pair over the bound (and with
     /// [`StopReason::NoValidPair`](super::StopReason::NoValidPair) when the checks
