@@ -42,6 +42,7 @@
 
 mod attributes;
 mod bvh;
+mod corner_store;
 mod facing;
 mod pieces;
 

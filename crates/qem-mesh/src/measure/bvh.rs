@@ -18,6 +18,7 @@
 //! when it is farther than the pruning bound; the answers themselves come from the
 //! exact `f64` triangle distances at the leaves.
 
+use super::corner_store::CornerStore;
 use super::facing::MIN_PRUNING_LENGTH;
 use super::pieces;
 use super::{cross, length, sub, triangle_distance2, P3};
@@ -228,7 +229,7 @@ pub struct TriangleBvh {
     pub(super) nodes: Vec<WideNode>,
     /// Triangle corners, numbered in the order the leaves first meet them: without
     /// pieces, a leaf's triangles are contiguous.
-    pub(super) corners: Vec<[P3; 3]>,
+    pub(super) corners: CornerStore,
     /// The triangle of each leaf entry, when some triangle is indexed in pieces (see
     /// the module docs); `None` when every leaf entry is its own triangle, in order.
     pub(super) pieces: Option<Vec<u32>>,
@@ -270,9 +271,12 @@ impl TriangleBvh {
             .all(|t| t.iter().all(|&i| (i as usize) < n));
         if all_valid {
             let (triangles, positions) = (&mesh.triangles, &mesh.positions);
-            Self::from_corner_fn(triangles.len(), |t| {
-                triangles[t].map(|i| to_index(positions[i as usize]))
-            })
+            Self::from_points(
+                triangles.len(),
+                n,
+                |t| triangles[t],
+                |v| to_index(positions[v as usize]),
+            )
         } else {
             // Left out, as documented; a validated mesh never comes this way.
             let corners: Vec<[P3; 3]> = mesh
@@ -289,25 +293,43 @@ impl TriangleBvh {
 
     /// The index over these triangles (given by their corners), and where each went:
     /// `slots[i]` is the index (for [`corners`](Self::corners)) of `corners[i]`.
-    /// Triangles are numbered with `u32`: at most `u32::MAX` of them are indexed (about
-    /// 300 GB of corners), the rest are left out. Corners should be finite (as a
+    /// Corners are numbered with `u32`: at most `u32::MAX / 3` triangles are indexed
+    /// (about 100 GB of corners), the rest are left out. Corners should be finite (as a
     /// validated mesh's are): a triangle with a NaN corner is never found by the
-    /// searches. (The index holds its own copy of the corners, in leaf order; a mesh
-    /// is better given to [`from_triangles`](Self::from_triangles), which needs no
-    /// list.)
+    /// searches. (The index holds its own copy of the corners; a mesh is better given
+    /// to [`from_triangles`](Self::from_triangles), whose shared vertices the index
+    /// then stores once.)
     pub fn from_corners(corners: Vec<[P3; 3]>) -> (TriangleBvh, Vec<u32>) {
-        Self::from_corner_fn(corners.len(), |t| corners[t])
+        let count = corners.len().min(u32::MAX as usize / 3);
+        Self::from_points(
+            count,
+            3 * count,
+            |t| {
+                let first = 3 * t as u32;
+                [first, first + 1, first + 2]
+            },
+            |v| corners[v as usize / 3][v as usize % 3],
+        )
     }
 
-    /// The index over `count` triangles, triangle `t` having corners `corners_of(t)`
-    /// (asked several times per triangle, from several threads: it must give the same
-    /// bits each time), and where each went (as [`from_corners`](Self::from_corners)).
-    fn from_corner_fn(
+    /// The index over `count` triangles, triangle `t` made of points `points_of(t)`
+    /// (each below `point_count`), point `v` being `point(v)` (asked several times per
+    /// point, from several threads: it must give the same bits each time), and where
+    /// each triangle went (as [`from_corners`](Self::from_corners)).
+    fn from_points(
         count: usize,
-        corners_of: impl Fn(usize) -> [P3; 3] + Sync,
+        point_count: usize,
+        points_of: impl Fn(usize) -> [u32; 3] + Sync,
+        point: impl Fn(u32) -> P3 + Sync,
     ) -> (TriangleBvh, Vec<u32>) {
         let count = count.min(u32::MAX as usize);
-        let (nodes, corners, slots, root, pieces) = build(count, &corners_of);
+        let source = Source {
+            count,
+            point_count,
+            points_of,
+            point,
+        };
+        let (nodes, corners, slots, root, pieces) = build(&source);
         let scale = (0..3)
             .map(|k| root.lo[k].abs().max(root.hi[k].abs()))
             .fold(0.0, f64::max);
@@ -393,7 +415,7 @@ impl TriangleBvh {
         let best = std::cell::Cell::new(f64::INFINITY);
         let mut prune = || best.get() * PRUNE_FACTOR + self.slack2;
         let mut leaf = |t: usize| {
-            let [a, b, c] = self.corners[t];
+            let [a, b, c] = self.corners.get(t);
             best.set(best.get().min(triangle_distance2(p, a, b, c)));
         };
         let mut stack = NodeStack::with((0u32, 0.0f64));
@@ -478,7 +500,7 @@ impl TriangleBvh {
             }
         };
         let mut leaf = |i: usize| {
-            let [a, b, c] = self.corners[i];
+            let [a, b, c] = self.corners.get(i);
             let d2 = triangle_distance2(p, a, b, c);
             best2.set(best2.get().min(d2));
             // A NaN distance (a NaN corner or point) makes no candidate: it would sort
@@ -526,8 +548,8 @@ impl TriangleBvh {
     /// The squared distance from `p` to triangle `i` (an index for
     /// [`corners`](Self::corners)); `None` when `i` is out of range.
     pub fn distance_squared_to(&self, p: [f64; 3], i: u32) -> Option<f64> {
-        let [a, b, c] = self.corners.get(i as usize)?;
-        Some(triangle_distance2(p, *a, *b, *c))
+        let [a, b, c] = self.corners.checked(i as usize)?;
+        Some(triangle_distance2(p, a, b, c))
     }
 
     /// Number of indexed triangles (those of the mesh with valid indices); indices for
@@ -539,19 +561,13 @@ impl TriangleBvh {
     /// The corners of triangle `i` (an index from
     /// [`nearest_triangles`](Self::nearest_triangles)), in their input order.
     pub fn corners(&self, i: u32) -> [[f64; 3]; 3] {
-        self.corners[i as usize]
+        self.corners.get(i as usize)
     }
 }
 
 /// What [`build`] returns: the nodes, the corners in leaf order, where each triangle
 /// went, the root's box, and the pieces' triangles (when there are pieces).
-type Built = (
-    Vec<WideNode>,
-    Vec<[P3; 3]>,
-    Vec<u32>,
-    Aabb,
-    Option<Vec<u32>>,
-);
+type Built = (Vec<WideNode>, CornerStore, Vec<u32>, Aabb, Option<Vec<u32>>);
 
 /// The tree over the `count` triangles whose corners `corners_of` gives (those
 /// corners returned in leaf order, see [`TriangleBvh::corners`]), node 0 the root,
@@ -574,7 +590,9 @@ type Built = (
 /// range's box computed as its split was made read every triangle's 72 bytes of
 /// corners at random, once per level; that was most of the index build, then the
 /// longer half of the simplifier's setup.
-fn build(count: usize, corners_of: &(impl Fn(usize) -> [P3; 3] + Sync)) -> Built {
+fn build(source: &Source<impl PointsOf, impl PointAt>) -> Built {
+    let count = source.count;
+    let corners_of = &|t| source.corners(t);
     let mut root_bounds = Aabb::EMPTY;
     for t in 0..count {
         for corner in corners_of(t) {
@@ -585,15 +603,46 @@ fn build(count: usize, corners_of: &(impl Fn(usize) -> [P3; 3] + Sync)) -> Built
     let (nodes, corners, slots, pieces) =
         match pieces::piece_counts(count, corners_of, length(extent)) {
             None => {
-                let (nodes, corners, slots) = build_whole(count, corners_of);
+                let (nodes, corners, slots) = build_whole(source);
                 (nodes, corners, slots, None)
             }
             Some(counts) => {
-                let (nodes, corners, slots, pieces) = build_in_pieces(corners_of, &counts);
+                let (nodes, corners, slots, pieces) = build_in_pieces(source, &counts);
                 (nodes, corners, slots, Some(pieces))
             }
         };
     (nodes, corners, slots, root_bounds, pieces)
+}
+
+/// Which points make triangle `t`, for [`Source`].
+trait PointsOf: Fn(usize) -> [u32; 3] + Sync {}
+impl<F: Fn(usize) -> [u32; 3] + Sync> PointsOf for F {}
+
+/// Point `v`, for [`Source`].
+trait PointAt: Fn(u32) -> P3 + Sync {}
+impl<F: Fn(u32) -> P3 + Sync> PointAt for F {}
+
+/// The triangles an index is built over: `count` of them, triangle `t` made of points
+/// `points_of(t)` (each below `point_count`), point `v` being `point(v)`.
+struct Source<T, P> {
+    count: usize,
+    point_count: usize,
+    points_of: T,
+    point: P,
+}
+
+impl<T: PointsOf, P: PointAt> Source<T, P> {
+    /// The corners of triangle `t`.
+    #[inline]
+    fn corners(&self, t: usize) -> [P3; 3] {
+        (self.points_of)(t).map(|v| (self.point)(v))
+    }
+
+    /// The corners of the triangles `order` names, in that order, each point stored
+    /// once.
+    fn gather(&self, order: impl ExactSizeIterator<Item = usize>) -> CornerStore {
+        CornerStore::gather(order, self.point_count, &self.points_of, &self.point)
+    }
 }
 
 /// A NaN coordinate (from infinite or NaN corners, which callers should not pass)
@@ -606,15 +655,14 @@ fn canonical(p: P3) -> P3 {
 /// [`build`] with a leaf entry per triangle: the nodes, the corners in leaf order and
 /// where each triangle went.
 fn build_whole(
-    count: usize,
-    corners_of: &(impl Fn(usize) -> [P3; 3] + Sync),
-) -> (Vec<WideNode>, Vec<[P3; 3]>, Vec<u32>) {
+    source: &Source<impl PointsOf, impl PointAt>,
+) -> (Vec<WideNode>, CornerStore, Vec<u32>) {
     // The centroids, kept for the split only: recomputing them inside the median
     // selection's comparisons made the dragon's index build about 0.3 s slower.
-    let mut order: Vec<Split> = (0..count)
+    let mut order: Vec<Split> = (0..source.count)
         .into_par_iter()
         .map(|entry| {
-            let c = corners_of(entry);
+            let c = source.corners(entry);
             Split {
                 centroid: canonical([0, 1, 2].map(|k| (c[0][k] + c[1][k] + c[2][k]) / 3.0)),
                 entry: entry as u32,
@@ -622,10 +670,7 @@ fn build_whole(
         })
         .collect();
     partition(&mut order);
-    let corners: Vec<[P3; 3]> = order
-        .par_iter()
-        .map(|split| corners_of(split.entry as usize))
-        .collect();
+    let corners = source.gather(order.iter().map(|split| split.entry as usize));
     let mut slots = vec![0u32; order.len()];
     for (slot, split) in order.iter().enumerate() {
         slots[split.entry as usize] = slot as u32;
@@ -633,8 +678,8 @@ fn build_whole(
     drop(order);
     let mut nodes = wide_nodes(corners.len());
     fill_boxes(&mut nodes, |entry| {
-        let c = &corners[entry];
-        (*c, pieces::piece_box(c, 0, 1))
+        let c = corners.get(entry);
+        (c, pieces::piece_box(&c, 0, 1))
     });
     (nodes, corners, slots)
 }
@@ -643,9 +688,9 @@ fn build_whole(
 /// Triangles are numbered in the order the leaves first meet them. Returns the nodes,
 /// the corners in that order, where each triangle went and each leaf entry's triangle.
 fn build_in_pieces(
-    corners_of: &(impl Fn(usize) -> [P3; 3] + Sync),
+    source: &Source<impl PointsOf, impl PointAt>,
     counts: &[u8],
-) -> (Vec<WideNode>, Vec<[P3; 3]>, Vec<u32>, Vec<u32>) {
+) -> (Vec<WideNode>, CornerStore, Vec<u32>, Vec<u32>) {
     // first[t]: the number of triangle t's first piece; pieces are numbered triangle
     // by triangle (u32: the budget keeps their count within PIECES_PER_TRIANGLE times the triangles').
     let mut first = Vec::with_capacity(counts.len() + 1);
@@ -663,7 +708,7 @@ fn build_in_pieces(
         .into_par_iter()
         .map(|entry| {
             let (t, j, k) = triangle_and_piece(entry);
-            let c = corners_of(t);
+            let c = source.corners(t);
             let centroid = canonical(if k == 1 {
                 [0, 1, 2].map(|i| (c[0][i] + c[1][i] + c[2][i]) / 3.0)
             } else {
@@ -687,13 +732,13 @@ fn build_in_pieces(
         }
         leaf_triangles.push(slots[t]);
     }
-    let corners: Vec<[P3; 3]> = by_slot.par_iter().map(|&t| corners_of(t)).collect();
+    let corners = source.gather(by_slot.iter().copied());
     drop(by_slot);
     let mut nodes = wide_nodes(order.len());
     fill_boxes(&mut nodes, |entry| {
         let (_, j, k) = triangle_and_piece(order[entry]);
-        let c = &corners[leaf_triangles[entry] as usize];
-        (*c, pieces::piece_box(c, j, k))
+        let c = corners.get(leaf_triangles[entry] as usize);
+        (c, pieces::piece_box(&c, j, k))
     });
     (nodes, corners, slots, leaf_triangles)
 }
@@ -948,11 +993,16 @@ mod tests {
     #[test]
     fn the_node_count_is_exact() {
         for n in [0usize, 1, 4, 5, 9, 17, 100, 1000, 4097] {
-            let corners_of = |i: usize| {
-                let x = i as f64;
-                [[x, 0.0, 0.0], [x, 1.0, 0.0], [x, 0.0, 1.0]]
+            let source = Source {
+                count: n,
+                point_count: 3 * n,
+                points_of: |t: usize| [0, 1, 2].map(|k| (3 * t + k) as u32),
+                point: |v: u32| {
+                    let x = f64::from(v / 3);
+                    [[x, 0.0, 0.0], [x, 1.0, 0.0], [x, 0.0, 1.0]][v as usize % 3]
+                },
             };
-            let (nodes, ..) = build(n, &corners_of);
+            let (nodes, ..) = build(&source);
             assert_eq!(nodes.len(), wide_node_count(n), "{n} triangles");
         }
     }
@@ -992,7 +1042,7 @@ mod tests {
                 for (entry, seen) in seen.iter_mut().enumerate().skip(start).take(count) {
                     assert_eq!(bvh.triangle_of(entry), entry);
                     *seen += 1;
-                    for corner in &bvh.corners[entry] {
+                    for corner in &bvh.corners.get(entry) {
                         for (k, &x) in corner.iter().enumerate() {
                             assert!(f64::from(lane.lo[k]) <= x && x <= f64::from(lane.hi[k]));
                         }

@@ -76,14 +76,14 @@ impl TriangleBvh {
                 }
                 let start = node.child[i] as usize;
                 for entry in start..start + count {
-                    let [a, b, c] = &self.corners[self.triangle_of(entry)];
-                    let t = cross(sub(*b, *a), sub(*c, *a));
+                    let [a, b, c] = self.corners.get(self.triangle_of(entry));
+                    let t = cross(sub(b, a), sub(c, a));
                     // "Not positive", NaN included, exactly as the caller's full test
                     // asks it (a zero normal has no say there either).
                     let d = dot(t, normal);
                     if (d <= 0.0 || d.is_nan())
                         && t != [0.0; 3]
-                        && triangle_distance2(p, *a, *b, *c) <= radius2
+                        && triangle_distance2(p, a, b, c) <= radius2
                     {
                         return true;
                     }
