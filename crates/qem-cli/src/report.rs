@@ -75,26 +75,14 @@ pub struct DroppedJson {
 }
 
 impl AttributesJson {
-    /// What became of `input`'s attributes in the simplified mesh's `output`,
-    /// written in `format`.
-    pub fn new(input: &Attributes, output: &Attributes, format: Format) -> Self {
-        let present = |a: &Attributes| -> Vec<String> {
-            let mut names: Vec<String> = a.channels.iter().map(|c| c.name.clone()).collect();
-            for (what, there) in [
-                ("materials", !a.materials.is_empty()),
-                ("groups", !a.groups.is_empty()),
-                ("material libraries", !a.material_libraries.is_empty()),
-            ] {
-                if there {
-                    names.push(what.to_string());
-                }
-            }
-            names
-        };
-        let kept = present(output);
+    /// What became of the input's attributes (`input`, their names as
+    /// [`AttributesJson::names`] gives them) in the simplified mesh's `output`, written
+    /// in `format`.
+    pub fn new(input: Vec<String>, output: &Attributes, format: Format) -> Self {
+        let kept = Self::names(output);
         let not_written = unwritable(output, format);
         let mut json = AttributesJson::default();
-        for what in present(input) {
+        for what in input {
             if !kept.contains(&what) {
                 json.dropped.push(DroppedJson {
                     what,
@@ -110,6 +98,22 @@ impl AttributesJson {
             }
         }
         json
+    }
+
+    /// The names of what `a` holds, as the report gives them: its channels, then
+    /// `materials`, `groups` and `material libraries` when it has them.
+    pub fn names(a: &Attributes) -> Vec<String> {
+        let mut names: Vec<String> = a.channels.iter().map(|c| c.name.clone()).collect();
+        for (what, there) in [
+            ("materials", !a.materials.is_empty()),
+            ("groups", !a.groups.is_empty()),
+            ("material libraries", !a.material_libraries.is_empty()),
+        ] {
+            if there {
+                names.push(what.to_string());
+            }
+        }
+        names
     }
 
     /// `carried: uv, normal; dropped: colour (STL holds positions only)`, or `None`

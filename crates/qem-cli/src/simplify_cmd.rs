@@ -8,7 +8,8 @@ use crate::report::{write_json_atomically, AttributesJson, LevelJson, LevelsJson
 use clap::Args;
 use qem_mesh::io::{read_path, write_path, Format, ReadNotes};
 use qem_mesh::simplify::{
-    simplify_levels, simplify_observed, Observer, Simplified, SimplifyOptions, StopReason, Target,
+    simplify_levels_owned, simplify_owned, Observer, Simplified, SimplifyOptions, StopReason,
+    Target,
 };
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -96,8 +97,10 @@ pub fn simplify_file(
     create_dirs: bool,
 ) -> Result<SimplifyJson, Failure> {
     let (mesh, notes, load) = load(input)?;
+    let input_attributes = AttributesJson::names(&mesh.attributes);
     let clock = Instant::now();
-    let result = simplify_observed(&mesh, options, observer)
+    // Handed over: the engine drops it once cleaned (see `simplify_owned`).
+    let result = simplify_owned(mesh, options, observer)
         .map_err(|e| Failure::Failed(format!("{}: {e}", input.display())))?;
     let simplify_time = clock.elapsed();
     if result.report.stop_reason == StopReason::Cancelled || interrupted() {
@@ -124,18 +127,15 @@ pub fn simplify_file(
         simplify_time,
         write,
     )
-    .with_attributes(attributes_of(&mesh, &result, output)))
+    .with_attributes(attributes_of(input_attributes, &result, output)))
 }
 
-/// What became of `mesh`'s attributes in `result`, written to `output`.
-fn attributes_of(
-    mesh: &qem_mesh::IndexedMesh,
-    result: &Simplified,
-    output: &Path,
-) -> AttributesJson {
+/// What became of the input's attributes (`input`, as [`AttributesJson::names`] gives
+/// them) in `result`, written to `output`.
+fn attributes_of(input: Vec<String>, result: &Simplified, output: &Path) -> AttributesJson {
     // The output's name was checked before it was written, so it has a format.
     let format = Format::from_path(output).unwrap_or(Format::Obj);
-    AttributesJson::new(&mesh.attributes, &result.mesh.attributes, format)
+    AttributesJson::new(input, &result.mesh.attributes, format)
 }
 
 fn load(input: &Path) -> Result<(qem_mesh::IndexedMesh, ReadNotes, Duration), Failure> {
@@ -183,19 +183,20 @@ fn run_levels(args: &SimplifyArgs) -> Result<(), Failure> {
     let bar = simplify_bar(bars_wanted(args.quiet), &file_name(&args.input));
     let result = (|| {
         let (mesh, notes, load) = load(&args.input)?;
+        let input_attributes = AttributesJson::names(&mesh.attributes);
         let targets: Vec<Target> = args.lods.iter().map(|&r| Target::Ratio(r)).collect();
         let clock = Instant::now();
-        let levels = simplify_levels(
-            &mesh,
+        let levels = simplify_levels_owned(
+            mesh,
             &args.flags.options()?,
             &targets,
             &mut BarObserver::new(&bar),
         )
         .map_err(|e| Failure::Failed(format!("{}: {e}", args.input.display())))?;
-        Ok((mesh, levels, notes, load, clock.elapsed()))
+        Ok((input_attributes, levels, notes, load, clock.elapsed()))
     })();
     bar.finish_and_clear();
-    let (mesh, levels, notes, load, simplify_time) = result?;
+    let (input_attributes, levels, notes, load, simplify_time) = result?;
     if interrupted()
         || levels
             .iter()
@@ -220,7 +221,7 @@ fn run_levels(args: &SimplifyArgs) -> Result<(), Failure> {
             simplify_time,
             write,
         )
-        .with_attributes(attributes_of(&mesh, level, output));
+        .with_attributes(attributes_of(input_attributes.clone(), level, output));
         if !args.quiet {
             eprintln!("level {lod} (ratio {ratio}): {}", run.summary_line());
         }

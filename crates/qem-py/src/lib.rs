@@ -891,10 +891,10 @@ fn simplify<'py>(
     };
     let (result, elapsed) = py.detach(|| {
         let clock = Instant::now();
-        let result = qem_mesh::simplify::simplify_observed(&mesh, &options, &mut observer);
+        // Handed over: dropped once cleaned, before the setup and the loop.
+        let result = qem_mesh::simplify::simplify_owned(mesh, &options, &mut observer);
         (result, clock.elapsed())
     });
-    drop(mesh);
     if let Some(error) = observer.error.take() {
         return Err(error);
     }
