@@ -50,8 +50,14 @@ impl Engine {
         // Never contract the last faces away: the output must keep a triangle.
         let left = live - shared.min(live);
         let merged = self.merged_away(a, b, &around, [left, target]);
-        let attempt = if shared + merged.len() >= live {
+        let removed = shared + merged.len();
+        let attempt = if removed >= live {
             self.counters.reject(Rejection::LastTriangles);
+            Attempt::Refused
+        } else if live - removed < target && !self.ladder.may_pass_target {
+            // Put off while a pair that removes fewer may land on the target (not a
+            // check's refusal: it is tried again once none does).
+            self.ladder.put_off_past_target = true;
             Attempt::Refused
         } else {
             let star = Star {

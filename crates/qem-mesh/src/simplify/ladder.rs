@@ -41,7 +41,9 @@ impl Engine {
             .filter(|(_, step)| !options.strict && step.allowed(options))
             .collect();
         let climbable: Vec<RelaxationStep> = steps.iter().map(|&(_, step)| step).collect();
-        let mut reason = self.run_order(options.order, target, observer);
+        self.ladder.may_pass_target = false;
+        self.ladder.put_off_past_target = false;
+        let mut reason = self.run_landing(options.order, target, observer);
         let mut climb = 0;
         while reason == StopReason::NoValidPair {
             let Some(&(slot, _)) = steps.get(climb) else {
@@ -52,7 +54,7 @@ impl Engine {
             self.ladder.contractions[slot].get_or_insert(0);
             self.retry(options.order);
             let (before, refused_before) = (self.counters.contractions(), self.counters.rejected);
-            reason = self.run_order(options.order, target, observer);
+            reason = self.run_landing(options.order, target, observer);
             let made = self.counters.contractions() - before;
             *self.ladder.contractions[slot].get_or_insert(0) += made;
             self.settings = every_check;
@@ -71,12 +73,39 @@ impl Engine {
             // pass them.
             climb = 0;
             self.retry(options.order);
-            reason = self.run_order(options.order, target, observer);
+            reason = self.run_landing(options.order, target, observer);
         }
         if reason == StopReason::NoValidPair && options.strict {
             self.ladder.stopped_by = Some(Constraint::Strict);
         }
         reason
+    }
+
+    /// One run of `order` that lands on `target` when it can: a contraction that would
+    /// take the count below the target is put off while another may land on it (a
+    /// border edge removes one triangle where an inner edge removes two); when no pair
+    /// is left but those, they may pass it, and the order runs once more.
+    ///
+    /// Why: a run asked for 28 triangles ended at 27, 9 at 8 (the corpus's small
+    /// meshes at ratio 0.01, where the count asked is within 1% only when met
+    /// exactly). Far from the target nothing is put off, so it costs nothing there;
+    /// near it, at most one more pass or queue.
+    pub(super) fn run_landing(
+        &mut self,
+        order: ContractionOrder,
+        target: usize,
+        observer: &mut dyn Observer,
+    ) -> StopReason {
+        let reason = self.run_order(order, target, observer);
+        if reason != StopReason::NoValidPair
+            || !self.ladder.put_off_past_target
+            || self.ladder.may_pass_target
+        {
+            return reason;
+        }
+        self.ladder.may_pass_target = true;
+        self.retry(order);
+        self.run_order(order, target, observer)
     }
 
     /// One run of `order`.

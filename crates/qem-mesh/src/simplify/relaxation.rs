@@ -137,6 +137,13 @@ pub(super) struct Ladder {
     pub contractions: [Option<usize>; RelaxationStep::ALL.len()],
     /// What stopped the last run that stopped with no pair left.
     pub stopped_by: Option<Constraint>,
+    /// Whether a contraction may take the count below the target (see
+    /// [`Engine::run_landing`](super::engine::Engine::run_landing)); set for each
+    /// level once no pair lands on it.
+    pub may_pass_target: bool,
+    /// Whether an attempt was put off because it would have taken the count below
+    /// the target while that was not allowed.
+    pub put_off_past_target: bool,
 }
 
 impl Ladder {

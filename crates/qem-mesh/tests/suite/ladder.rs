@@ -2,7 +2,7 @@
 //! relaxes them, step by step, instead of stopping short; `strict` and the user's own
 //! constraints stop it, and the report says what did.
 
-use crate::common::{assert_valid, concat, simplify_replayed, topology, uv_sphere};
+use crate::common::{assert_valid, concat, grid, simplify_replayed, topology, uv_sphere};
 use qem_mesh::simplify::{
     simplify, BoundaryMode, Constraint, ContractionOrder, RelaxationStep, SimplifyOptions,
     StopReason, Target,
@@ -343,5 +343,42 @@ fn the_gantry_keeps_its_rods_at_one_percent() {
         // read 1.28% while it did not cost a pair again when popping it (a contraction
         // elsewhere had made it a vanishing one).
         assert!(m.hausdorff < 0.012, "{what}: Hausdorff {}", m.hausdorff);
+    }
+}
+
+/// A run lands on the count asked for when a pair that removes one triangle (a border
+/// edge) can take the last step, rather than passing it with one that removes two.
+#[test]
+fn a_run_lands_on_its_target_when_a_border_edge_can_take_the_last_step() {
+    let mesh = grid(12, 12, 0.8);
+    assert_eq!(mesh.triangle_count(), 288);
+    for order in ORDERS {
+        let mut landed = Vec::new();
+        for target in [251, 143, 77, 41, 23, 11] {
+            let out = simplify_replayed(&mesh, &options(order, Target::Triangles(target)))
+                .expect("simplifies");
+            assert_valid(&out.mesh, 288);
+            assert_eq!(out.report.stop_reason, StopReason::TargetReached);
+            landed.push(out.mesh.triangle_count());
+        }
+        assert_eq!(landed, [251, 143, 77, 41, 23, 11], "{order:?}");
+    }
+}
+
+/// A closed mesh has an even count of triangles: a target one below an even count is
+/// passed by one, as before (each contraction removes two), not missed.
+#[test]
+fn a_closed_mesh_passes_an_odd_target_by_one() {
+    let mesh = uv_sphere([0.0; 3], 1.0, 12, 16);
+    let n = mesh.triangle_count();
+    for order in ORDERS {
+        let out =
+            simplify(&mesh, &options(order, Target::Triangles(n / 2 + 1))).expect("simplifies");
+        assert_eq!(
+            out.report.stop_reason,
+            StopReason::TargetReached,
+            "{order:?}"
+        );
+        assert_eq!(out.mesh.triangle_count(), n / 2, "{order:?}");
     }
 }
