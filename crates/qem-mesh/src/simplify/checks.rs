@@ -5,6 +5,40 @@ use super::settings::Settings;
 use crate::clean::cross_underflows;
 use qem_core::{DVec3, Frame};
 
+/// Which way an input triangle faces, as the checks keep it: its unit normal in `f32`
+/// (zero for a triangle without area).
+///
+/// Why `f32`: the checks ask only the sign of its dot product with a moved face's
+/// normal (has the face turned more than 90° from the input face it descends from?),
+/// and a unit normal in `f32` gives that sign unless the angle is within about 1e-7
+/// radian of 90°, where either answer is right. 12 bytes a triangle where the `f64`
+/// normal took 24 (48 MB on a 4M-triangle mesh, kept for the whole run).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(super) struct Facing([f32; 3]);
+
+impl Facing {
+    /// The facing of a triangle whose (unnormalised) normal is `normal`.
+    pub fn of(normal: DVec3) -> Facing {
+        let length = normal.length();
+        if length > 0.0 && length.is_finite() {
+            let unit = normal / length;
+            Facing([unit.x as f32, unit.y as f32, unit.z as f32])
+        } else {
+            Facing::default()
+        }
+    }
+
+    /// The unit normal (zero for a triangle without area).
+    #[inline]
+    pub fn normal(self) -> DVec3 {
+        DVec3::new(
+            f64::from(self.0[0]),
+            f64::from(self.0[1]),
+            f64::from(self.0[2]),
+        )
+    }
+}
+
 /// Why a contraction was refused (each has a counter in the report).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Rejection {

@@ -18,7 +18,7 @@
 //! space-filling curve), so "in order" is also "near in space", whatever order the
 //! input came in; the output and the observer get the cleaned mesh's numbers back.
 
-use super::checks::Rejection;
+use super::checks::{Facing, Rejection};
 use super::counters::Counters;
 use super::incidence::Incidence;
 use super::locality::{in_locality_order, in_original_order, Renumbered};
@@ -114,8 +114,8 @@ pub(super) struct Engine {
     triangles: Vec<[u32; 3]>,
     /// The indices of the live triangles, in increasing order.
     live: Vec<u32>,
-    /// Each input triangle's (unnormalised) normal in the normalised frame.
-    original_normals: Vec<DVec3>,
+    /// Which way each input triangle faces (in the normalised frame).
+    original_normals: Vec<Facing>,
     /// The pass in which each vertex last moved or was removed.
     moved_in: Vec<u32>,
     pass: u32,
@@ -461,14 +461,14 @@ impl Engine {
             .into_par_iter()
             .map(|t| {
                 if is_live.as_ref().is_some_and(|live| !live[t]) {
-                    return (DVec3::ZERO, WeightedPlane::NONE);
+                    return (Facing::default(), WeightedPlane::NONE);
                 }
                 let [pa, pb, pc] = triangles[t].map(|c| position[c as usize]);
                 let plane = match area_offset {
                     Some(extra) => WeightedPlane::from_triangle_area_plus(pa, pb, pc, extra),
                     None => WeightedPlane::from_triangle_unweighted(pa, pb, pc),
                 };
-                ((pb - pa).cross(pc - pa), plane)
+                (Facing::of((pb - pa).cross(pc - pa)), plane)
             })
             .unzip_into_vecs(&mut normals, &mut planes);
         // Each vertex's quadric, summed over its live triangles in the order of
@@ -932,7 +932,7 @@ impl Engine {
                 let [p0, p1, p2] = self.corners(self.triangles[t as usize]);
                 (p1 - p0)
                     .cross(p2 - p0)
-                    .dot(self.original_normals[t as usize])
+                    .dot(self.original_normals[t as usize].normal())
                     < 0.0
             })
             .count()

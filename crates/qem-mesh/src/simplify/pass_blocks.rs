@@ -33,7 +33,7 @@
 //! the first round of passes 1-3 were interior (counted in a scratch build). (BENCHMARKS.md,
 //! "Rounds block by block".)
 
-use super::checks::{moved_face_verdict, Rejection};
+use super::checks::{moved_face_verdict, Facing, Rejection};
 use super::counters::Counters;
 use super::incidence::Incidence;
 use super::observer::Contraction;
@@ -74,8 +74,8 @@ pub(super) struct Fixed<'a> {
     pub settings: &'a Settings,
     /// The live triangles around each vertex at the pass's start.
     pub incidence: &'a Incidence,
-    /// Each input triangle's normal (normalised frame).
-    pub original_normals: &'a [DVec3],
+    /// Which way each input triangle faces (normalised frame).
+    pub original_normals: &'a [Facing],
     /// Each engine vertex's number in the cleaned mesh (for the observer).
     pub vertex_from: &'a [u32],
     pub pass: u32,
@@ -144,7 +144,7 @@ impl Corners<'_> {
                 fixed.settings,
                 old,
                 new,
-                || fixed.original_normals[x.triangle as usize],
+                || fixed.original_normals[x.triangle as usize].normal(),
                 || {
                     cross_underflows(corners.map(|c| {
                         if c == a || c == b {
