@@ -346,22 +346,30 @@ fn the_gantry_keeps_its_rods_at_one_percent() {
     }
 }
 
-/// A run lands on the count asked for when a pair that removes one triangle (a border
-/// edge) can take the last step, rather than passing it with one that removes two.
+/// A run lands on the count asked for when passing it would miss it by more than 1%
+/// and a pair that removes one triangle (a border edge) can take the last step,
+/// rather than passing it with one that removes two; above 100 triangles, passing it
+/// by one is within 1% and the cheapest pair goes.
 #[test]
-fn a_run_lands_on_its_target_when_a_border_edge_can_take_the_last_step() {
+fn a_run_lands_on_a_small_target_when_a_border_edge_can_take_the_last_step() {
     let mesh = grid(12, 12, 0.8);
     assert_eq!(mesh.triangle_count(), 288);
     for order in ORDERS {
-        let mut landed = Vec::new();
+        let mut ended = Vec::new();
         for target in [251, 143, 77, 41, 23, 11] {
             let out = simplify_replayed(&mesh, &options(order, Target::Triangles(target)))
                 .expect("simplifies");
             assert_valid(&out.mesh, 288);
             assert_eq!(out.report.stop_reason, StopReason::TargetReached);
-            landed.push(out.mesh.triangle_count());
+            ended.push(out.mesh.triangle_count());
         }
-        assert_eq!(landed, [251, 143, 77, 41, 23, 11], "{order:?}");
+        assert_eq!(ended[2..], [77, 41, 23, 11], "{order:?}");
+        for (got, target) in ended[..2].iter().zip([251usize, 143]) {
+            assert!(
+                target - got <= target / 100,
+                "{order:?}: {got} for {target}"
+            );
+        }
     }
 }
 
