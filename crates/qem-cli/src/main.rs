@@ -10,6 +10,7 @@ mod failure;
 mod info_cmd;
 mod inputs;
 mod manifest;
+mod materials;
 mod measure_cmd;
 mod options;
 mod progress;

@@ -1,5 +1,6 @@
 //! JSON reports, written atomically. Field names are the documented JSON keys.
 
+use crate::materials::MaterialFilesJson;
 use qem_mesh::attributes::Attributes;
 use qem_mesh::inspect::MeshInfo;
 use qem_mesh::io::{unwritable, Format, ReadNotes};
@@ -55,6 +56,10 @@ pub struct SimplifyJson {
     /// The attribute channels and labels of the input that the output file carries,
     /// and those it does not, each with the reason.
     attributes: AttributesJson,
+    /// The files the output's material libraries name, copied from beside the input
+    /// (`copied`, `already_there`, `not_copied` with the reason); empty unless the
+    /// output is an OBJ with material libraries written to another directory.
+    material_files: MaterialFilesJson,
     timings_ms: BTreeMap<&'static str, f64>,
 }
 
@@ -239,6 +244,7 @@ impl SimplifyJson {
             faces_flipped: r.faces_flipped,
             read_notes: notes.into(),
             attributes: AttributesJson::default(),
+            material_files: MaterialFilesJson::default(),
             timings_ms,
         }
     }
@@ -246,6 +252,12 @@ impl SimplifyJson {
     /// The report with what became of the input's attributes.
     pub fn with_attributes(mut self, attributes: AttributesJson) -> Self {
         self.attributes = attributes;
+        self
+    }
+
+    /// The report with what became of the files the output's materials name.
+    pub fn with_material_files(mut self, material_files: MaterialFilesJson) -> Self {
+        self.material_files = material_files;
         self
     }
 }
@@ -283,10 +295,11 @@ impl SimplifyJson {
                 .collect();
             format!("; relaxed: {}", steps.join(", "))
         };
-        let attributes = self
-            .attributes
-            .summary()
-            .map_or(String::new(), |s| format!("; {s}"));
+        let attributes: String = [self.attributes.summary(), self.material_files.summary()]
+            .into_iter()
+            .flatten()
+            .map(|s| format!("; {s}"))
+            .collect();
         format!(
             "{} → {}: {} → {} triangles, max error {:.4}% of the bounding-box diagonal ({stop}){relaxed}{attributes}",
             self.input,

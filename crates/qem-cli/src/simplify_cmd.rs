@@ -2,6 +2,7 @@
 //! out, an optional JSON report.
 
 use crate::failure::Failure;
+use crate::materials::{copy_beside, MaterialFilesJson};
 use crate::options::{parse_ratio, SimplifyFlags};
 use crate::progress::{bars_wanted, interrupted, simplify_bar, BarObserver};
 use crate::report::{write_json_atomically, AttributesJson, LevelJson, LevelsJson, SimplifyJson};
@@ -127,7 +128,17 @@ pub fn simplify_file(
         simplify_time,
         write,
     )
-    .with_attributes(attributes_of(input_attributes, &result, output)))
+    .with_attributes(attributes_of(input_attributes, &result, output))
+    .with_material_files(material_files_of(input, output, &result)))
+}
+
+/// The files `result`'s material libraries name, copied beside `output` when it is an
+/// OBJ (the only format that names them).
+fn material_files_of(input: &Path, output: &Path, result: &Simplified) -> MaterialFilesJson {
+    if Format::from_path(output).ok() != Some(Format::Obj) {
+        return MaterialFilesJson::default();
+    }
+    copy_beside(input, output, &result.mesh.attributes.material_libraries)
 }
 
 /// What became of the input's attributes (`input`, as [`AttributesJson::names`] gives
@@ -221,7 +232,8 @@ fn run_levels(args: &SimplifyArgs) -> Result<(), Failure> {
             simplify_time,
             write,
         )
-        .with_attributes(attributes_of(input_attributes.clone(), level, output));
+        .with_attributes(attributes_of(input_attributes.clone(), level, output))
+        .with_material_files(material_files_of(&args.input, output, level));
         if !args.quiet {
             eprintln!("level {lod} (ratio {ratio}): {}", run.summary_line());
         }

@@ -227,7 +227,8 @@ def corner_rows(vertices, faces, uv):
 def test_load_with_attributes_is_per_vertex_and_keeps_every_corner():
     v0, f0 = qem.load(SPOT)
     v, f, a = qem.load(SPOT, attributes=True)
-    assert list(a) == ["uv"] and a["uv"].dtype == np.float32
+    assert list(a) == ["uv", "material", "material_names"] and a["uv"].dtype == np.float32
+    assert a["material_names"] == ["spot"] and (a["material"] == 0).all()
     assert a["uv"].shape == (len(v), 2) and len(f) == len(f0)
     assert len(v) > len(v0)  # split at the UV seams
     expected = np.unique(obj_corners(SPOT), axis=0)

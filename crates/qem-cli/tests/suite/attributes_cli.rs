@@ -41,8 +41,86 @@ fn spot_keeps_its_uvs_in_obj_and_the_report_says_so() {
             .all(|&x| (lo - 0.01..=hi + 0.01).contains(&x)),
         "uvs outside [{lo}, {hi}]"
     );
-    assert_eq!(json["attributes"]["carried"], serde_json::json!(["uv"]));
+    assert_eq!(
+        json["attributes"]["carried"],
+        serde_json::json!(["uv", "materials", "material libraries"])
+    );
     assert_eq!(json["attributes"]["dropped"], serde_json::json!([]));
+    assert_eq!(
+        json["material_files"]["copied"],
+        serde_json::json!(["spot.mtl", "spot_checker.png"])
+    );
+}
+
+/// An OBJ output written to another directory gets its material library and the
+/// textures it names beside it; names that leave the directory are not followed, a
+/// missing file is reported, and nothing already there is overwritten.
+#[test]
+fn material_files_follow_the_output_and_only_what_is_safe_is_copied() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, out) = (dir.path().join("in"), dir.path().join("out"));
+    std::fs::create_dir_all(input.join("tex")).unwrap();
+    std::fs::create_dir_all(&out).unwrap();
+    let spot_text = std::fs::read_to_string(spot()).unwrap();
+    let text = spot_text.replace("mtllib spot.mtl", "mtllib a.mtl ../outside.mtl missing.mtl");
+    assert_ne!(text, spot_text);
+    std::fs::write(input.join("m.obj"), text).unwrap();
+    std::fs::write(
+        input.join("a.mtl"),
+        "newmtl spot\nmap_Kd tex/a.png\nbump ../../escape.png\nmap_Ks kept.png\n",
+    )
+    .unwrap();
+    std::fs::write(input.join("tex/a.png"), b"texture").unwrap();
+    std::fs::write(input.join("kept.png"), b"new").unwrap();
+    std::fs::write(out.join("kept.png"), b"the user's own").unwrap();
+    std::fs::write(dir.path().join("outside.mtl"), b"newmtl x\n").unwrap();
+    let report = out.join("r.json");
+    let o = crate::common::qem(&[
+        "simplify",
+        crate::common::s(&input.join("m.obj")),
+        "-o",
+        crate::common::s(&out.join("m.obj")),
+        "--ratio",
+        "0.5",
+        "--report",
+        crate::common::s(&report),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let files = &crate::common::json(&report)["material_files"];
+    assert_eq!(files["copied"], serde_json::json!(["a.mtl", "tex/a.png"]));
+    assert_eq!(std::fs::read(out.join("tex/a.png")).unwrap(), b"texture");
+    assert_eq!(
+        std::fs::read(out.join("kept.png")).unwrap(),
+        b"the user's own"
+    );
+    let not_copied: Vec<(String, String)> = files["not_copied"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| {
+            (
+                n["file"].as_str().unwrap().into(),
+                n["reason"].as_str().unwrap().into(),
+            )
+        })
+        .collect();
+    let reason = |f: &str| {
+        not_copied
+            .iter()
+            .find(|(file, _)| file == f)
+            .map(|(_, r)| r.as_str())
+            .unwrap_or_else(|| panic!("{f} in {not_copied:?}"))
+    };
+    assert!(reason("../outside.mtl").contains("leaves the output's directory"));
+    assert!(reason("missing.mtl").contains("not found beside the input"));
+    assert!(reason("../../escape.png").contains("leaves the output's directory"));
+    assert!(reason("kept.png").contains("kept it"));
+    assert!(!dir.path().join("escape.png").exists());
+    assert!(
+        stderr(&o).contains("material files not copied: "),
+        "{}",
+        stderr(&o)
+    );
 }
 
 #[test]

@@ -119,12 +119,19 @@ fn bad_files_are_reported_and_the_rest_succeed() {
         .any(|l| l.starts_with("qem: error: ") && l.contains("scene.fbx")));
 
     // Outputs keep the relative path, in the input's own format, and nothing else is
-    // left in the output directory (no temporary files, nothing for failed inputs).
+    // left in the output directory (no temporary files, nothing for failed inputs)
+    // but spot.obj's material library, copied beside it.
     assert_eq!(
         files_under(&out),
-        ["grid.ply", "spot.obj", "sub/grid.stl", "sub/more.off"]
-            .map(PathBuf::from)
-            .to_vec()
+        [
+            "grid.ply",
+            "spot.mtl",
+            "spot.obj",
+            "sub/grid.stl",
+            "sub/more.off"
+        ]
+        .map(PathBuf::from)
+        .to_vec()
     );
     for entry in entries.iter().filter(|e| e.get("error").is_none()) {
         let output = Path::new(entry["output"].as_str().unwrap());
@@ -172,9 +179,15 @@ fn directories_are_walked_for_meshes_only() {
     assert_eq!(r["summary"]["failed"], 1);
     assert_eq!(
         files_under(&out),
-        ["grid.obj", "spot.obj", "sub/grid.obj", "sub/more.obj"]
-            .map(PathBuf::from)
-            .to_vec()
+        [
+            "grid.obj",
+            "spot.mtl",
+            "spot.obj",
+            "sub/grid.obj",
+            "sub/more.obj"
+        ]
+        .map(PathBuf::from)
+        .to_vec()
     );
     // --quiet: only the failure line.
     let e = stderr(&o);
@@ -207,9 +220,12 @@ fn all_good_exits_zero() {
         "20",
     ]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    // With spot.obj, its material library and texture.
     assert_eq!(
         files_under(&out),
-        vec![PathBuf::from("a.ply"), PathBuf::from("spot.obj")]
+        ["a.ply", "spot.mtl", "spot.obj", "spot_checker.png"]
+            .map(PathBuf::from)
+            .to_vec()
     );
     assert!(
         read_path(&out.join("spot.obj"))

@@ -49,8 +49,8 @@ fn levels_are_written_nested_and_reported() {
     }
     assert_eq!(
         std::fs::read_dir(dir.path()).unwrap().count(),
-        4,
-        "three levels and the report, nothing else"
+        6,
+        "three levels, the report, and spot's material library and texture beside them"
     );
 }
 
