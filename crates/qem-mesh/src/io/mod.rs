@@ -3,10 +3,20 @@
 //!
 //! # Reading
 //! [`read_path`] picks the format from the file name ([`Format::from_path`]: the
-//! extension, case-insensitive, after stripping a trailing `.gz`), reads the whole file
-//! into memory, decompresses it if it starts with the gzip magic bytes, and parses it
-//! with [`read_bytes`]. `read_bytes` is a pure function from arbitrary bytes to a mesh
-//! or an error: it never panics and never allocates more than the input can justify.
+//! extension, case-insensitive, after stripping a trailing `.gz`), decompresses the
+//! file as it reads it if it starts with the gzip magic bytes, and parses it as
+//! [`read_bytes`] parses bytes in memory, with the same result. `read_bytes` is a pure
+//! function from arbitrary bytes to a mesh or an error: it never panics and never
+//! allocates more than the input can justify.
+//!
+//! **Streaming.** Binary PLY and binary STL are read as they arrive, a chunk at a time
+//! (1 MiB), whole records out of each: reading a file takes about the memory of the
+//! arrays it gives, not the file's (or its decompressed data's) size on top (figures in
+//! BENCHMARKS.md, "Loading"). ASCII PLY and STL, OBJ, OFF and glTF are parsed from all
+//! their (decompressed) bytes at once. Whatever the form, the result and the errors are
+//! those of reading the whole data at once: an error that depends on what comes later
+//! (a cut element, a binary STL's size, a corrupt gzip stream) is given once the rest
+//! has been read.
 //!
 //! Polygons are fan-triangulated from their first corner. Vertices are never welded
 //! or removed by the PLY, STL and OFF readers (an STL facet gives three new vertices);
@@ -29,8 +39,11 @@
 //! is an error naming its line.
 //!
 //! **Bounded memory.** Counts above `MAX_ELEMENTS` are refused; no buffer is reserved
-//! beyond what the remaining bytes could hold; gzip output is capped at
-//! [`GZIP_MAX_RATIO`] times the compressed size and at [`GZIP_MAX_BYTES`].
+//! beyond what the remaining bytes could hold (for gzip data, whose size is known only
+//! at its end, beyond what has arrived: the arrays grow as the data arrives); gzip
+//! output is capped at [`GZIP_MAX_RATIO`] times the compressed size and at
+//! [`GZIP_MAX_BYTES`]. A streamed binary PLY record is held whole before it is read, so
+//! a list that claims more than the file holds costs at most the rest of the file.
 //!
 //! # Writing
 //! [`write_to`] writes any format to a `Write`; [`write_path`] writes a file
@@ -68,6 +81,7 @@ mod atomic;
 mod channels;
 mod error;
 pub mod gltf;
+mod input;
 pub mod obj;
 mod off;
 mod ply;
@@ -82,6 +96,7 @@ pub use atomic::{
     TEMP_MARKER,
 };
 pub use error::{IoError, Location, ReadError, ReadErrorKind};
+use input::Input;
 
 use crate::IndexedMesh;
 
@@ -92,9 +107,9 @@ pub const SUPPORTED_EXTENSIONS: &str =
 /// Decompressed gzip data may be at most this many times the compressed size (plus
 /// 64 KiB, so tiny files are never refused).
 ///
-/// Why 64: the whole decompressed file is held in memory, and deflate can expand up to
-/// about 1032:1, so a 1 MB "zip bomb" of whitespace would otherwise need over 2 GB
-/// (measured: 2.0 GB peak RSS, see FUZZING.md). Real meshes compress far less: gzip -9
+/// Why 64: the text formats hold the whole decompressed file in memory, and deflate can
+/// expand up to about 1032:1, so a 1 MB "zip bomb" of whitespace would otherwise need
+/// over 2 GB (measured: 2.0 GB peak RSS, see FUZZING.md). Real meshes compress far less: gzip -9
 /// of the project's 49-mesh corpus gives at most 9:1 (OBJ text); 64 leaves a margin of
 /// 7 times that while bounding memory at about 64 times the file size. What it refuses
 /// is data made of long repeats, such as millions of copies of one face.
@@ -279,46 +294,44 @@ pub(crate) fn strip_bom(bytes: &[u8]) -> (&[u8], bool) {
 /// assert_eq!(err.to_string(), "line 4: unexpected end of file after 2 of 3 vertices");
 /// ```
 pub fn read_bytes(bytes: &[u8], format: Format) -> Result<LoadedMesh, ReadError> {
-    read_with(bytes, format, None)
+    read_input(&mut Input::detect(bytes), format, None)
 }
 
-/// [`read_bytes`], with a way to open the external buffer files of glTF.
-fn read_with(
-    bytes: &[u8],
+/// Reads `input` in `format`; a `.gltf`'s external buffers are opened with `external`.
+fn read_input(
+    input: &mut Input<'_>,
     format: Format,
     external: Option<gltf::External<'_>>,
 ) -> Result<LoadedMesh, ReadError> {
-    if is_gzip(bytes) {
-        let data = gunzip(bytes)?;
-        return read_plain(&data, format, external);
-    }
-    read_plain(bytes, format, external)
+    let read = read_plain(input, format, external);
+    // A gzip error anywhere in the stream wins over what the reader found.
+    input.finish()?;
+    read
 }
 
 fn read_plain(
-    bytes: &[u8],
+    input: &mut Input<'_>,
     format: Format,
     external: Option<gltf::External<'_>>,
 ) -> Result<LoadedMesh, ReadError> {
-    if bytes.is_empty() {
+    input.fill(1)?;
+    if input.window().is_empty() {
         return Err(ReadError::new(ReadErrorKind::Empty, None));
     }
     let mut notes = ReadNotes::default();
     // A byte order mark is text's; binary STL's 80-byte header may start with any
     // bytes, so the STL reader decides for itself once it knows which form it reads.
-    let text = if format == Format::Stl {
-        bytes
-    } else {
-        let (rest, bom) = strip_bom(bytes);
-        notes.byte_order_mark = bom;
-        rest
-    };
+    if format != Format::Stl {
+        notes.byte_order_mark = input.skip_bom()?;
+    }
+    // Binary PLY and STL are read as they arrive; the other formats, and ASCII PLY and
+    // STL, are parsed from all their bytes at once.
     let mesh = match format {
-        Format::Obj => obj::read(text, &mut notes)?,
-        Format::Ply => ply::read(text, &mut notes)?,
-        Format::Stl => stl::read(text, &mut notes)?,
-        Format::Off => off::read(text, &mut notes)?,
-        Format::Gltf | Format::Glb => gltf::read(text, format, external, &mut notes)?,
+        Format::Obj => obj::read(&input.rest()?, &mut notes)?,
+        Format::Ply => ply::read(input, &mut notes)?,
+        Format::Stl => stl::read(input, &mut notes)?,
+        Format::Off => off::read(&input.rest()?, &mut notes)?,
+        Format::Gltf | Format::Glb => gltf::read(&input.rest()?, format, external, &mut notes)?,
     };
     let loaded = LoadedMesh { mesh, notes };
     // The parsers report most problems with a place; this is the safety net that makes
@@ -328,41 +341,6 @@ fn read_plain(
         .validate()
         .map_err(|e| ReadError::mesh(None, e))?;
     Ok(loaded)
-}
-
-fn is_gzip(bytes: &[u8]) -> bool {
-    bytes.starts_with(&[0x1f, 0x8b])
-}
-
-/// Decompresses gzip data (all members), refusing more than the documented caps.
-fn gunzip(bytes: &[u8]) -> Result<Vec<u8>, ReadError> {
-    let len = bytes.len() as u64;
-    let limit = len
-        .saturating_mul(GZIP_MAX_RATIO)
-        .saturating_add(1 << 16)
-        .min(GZIP_MAX_BYTES);
-    let mut out = Vec::new();
-    let mut decoder = flate2::read::MultiGzDecoder::new(bytes).take(limit.saturating_add(1));
-    decoder.read_to_end(&mut out).map_err(|e| {
-        ReadError::new(
-            ReadErrorKind::Gzip {
-                detail: format!("corrupt data after {} decompressed bytes: {e}", out.len()),
-            },
-            None,
-        )
-    })?;
-    if out.len() as u64 > limit {
-        return Err(ReadError::new(
-            ReadErrorKind::Gzip {
-                detail: format!(
-                    "decompresses to more than {limit} bytes \
-                     ({GZIP_MAX_RATIO}x the compressed size, at most {GZIP_MAX_BYTES})"
-                ),
-            },
-            None,
-        ));
-    }
-    Ok(out)
 }
 
 /// Reads a mesh file; the format comes from the name ([`Format::from_path`]),
@@ -389,14 +367,22 @@ pub fn read_path(path: &Path) -> Result<LoadedMesh, IoError> {
         source,
     };
     let format = Format::from_path(path).map_err(read_err)?;
-    let bytes = std::fs::read(path).map_err(|source| IoError::File {
+    let file_err = |source| IoError::File {
         path: path.to_path_buf(),
         action: "read",
         source,
-    })?;
+    };
+    let mut input = std::fs::File::open(path)
+        .and_then(Input::file)
+        .map_err(file_err)?;
     let dir = path.parent().unwrap_or(Path::new("."));
     let open = |uri: &str, len: usize| read_buffer_file(&dir.join(uri), len);
-    read_with(&bytes, format, Some(&open)).map_err(read_err)
+    let read = read_input(&mut input, format, Some(&open));
+    // The system's error reading the file, not a problem of its content.
+    if let Some(source) = input.take_file_error() {
+        return Err(file_err(source));
+    }
+    read.map_err(read_err)
 }
 
 /// The first `len` bytes of a glTF buffer file; fewer when the file is shorter, which

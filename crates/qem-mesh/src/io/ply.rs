@@ -56,9 +56,10 @@
 use std::io::Write;
 
 use super::channels::{all_levels, colours_on_faces, from_level, per_vertex, to_level};
+use super::input::Input;
 use super::off::fan;
 use super::text::{self, capacity_for, parse_f32, parse_f64, parse_i64, show, Tokens};
-use super::{sniff, Format, Location, ReadError, ReadNotes};
+use super::{sniff, Format, Location, ReadError, ReadErrorKind, ReadNotes};
 use crate::attributes::{Attributes, Channel, ChannelKind};
 use crate::{IndexedMesh, InputError, MAX_ELEMENTS};
 
@@ -700,10 +701,85 @@ impl Builder {
     }
 }
 
-pub(crate) fn read(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, ReadError> {
+/// Header bytes looked at first for `end_header`; a longer header is read in doubling
+/// steps.
+pub(crate) const HEADER_PREFIX: usize = 1 << 16;
+
+/// Reads a PLY file. A binary body is read as it arrives, whole records at a time;
+/// an ASCII one (and data that is not a PLY header) is parsed from all its bytes at
+/// once.
+pub(crate) fn read(input: &mut Input<'_>, notes: &mut ReadNotes) -> Result<IndexedMesh, ReadError> {
+    let mut want = HEADER_PREFIX;
+    loop {
+        input.fill(want)?;
+        let window = input.window();
+        let end = input.at_end();
+        // The window's lines are whole up to its last line break, or all of it at the
+        // end of the data: a header found in them is the whole data's header.
+        let cut = if end {
+            Some(window.len())
+        } else {
+            window.iter().rposition(|&b| b == b'\n').map(|i| i + 1)
+        };
+        let tried = cut.map(|cut| {
+            let mut trial = *notes;
+            parse_header(&window[..cut], &mut trial).map(|h| (h.encoding, h.body))
+        });
+        // Only "no end_header" says the header may go on past the window.
+        let goes_on = !end
+            && match &tried {
+                None => true,
+                Some(Err(e)) => matches!(e.kind(), ReadErrorKind::Truncated { .. }),
+                Some(Ok(_)) => false,
+            };
+        match tried {
+            Some(Ok((Encoding::Little | Encoding::Big, body))) => {
+                let head = window[..body].to_vec();
+                input.consume(body);
+                let header = parse_header(&head, notes)?;
+                return read_body(&head, &header, Body::Binary(input), notes);
+            }
+            _ if goes_on => want = window.len().saturating_mul(2),
+            // ASCII, or not a PLY header: decided on all the bytes.
+            _ => break,
+        }
+    }
+    read_all(&input.rest()?, notes)
+}
+
+/// Reads a PLY file from all its bytes.
+fn read_all(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, ReadError> {
     let header = parse_header(bytes, notes)?;
-    notes.non_utf8_lines += text::non_utf8_lines(bytes.get(..header.body).unwrap_or_default());
+    let head = bytes.get(..header.body).unwrap_or_default();
     let body = bytes.get(header.body..).unwrap_or_default();
+    let body = match header.encoding {
+        Encoding::Ascii => Body::Ascii(Tokens::new(body, header.body_line)),
+        Encoding::Little | Encoding::Big => {
+            return read_body(
+                head,
+                &header,
+                Body::Binary(&mut Input::plain_at(body, header.body as u64)),
+                notes,
+            )
+        }
+    };
+    read_body(head, &header, body, notes)
+}
+
+/// Where the elements' records come from.
+enum Body<'t, 'i, 'a> {
+    Ascii(Tokens<'t>),
+    Binary(&'i mut Input<'a>),
+}
+
+/// Reads the elements `header` declares from `body`; `head` is the header's bytes.
+fn read_body(
+    head: &[u8],
+    header: &Header,
+    mut body: Body,
+    notes: &mut ReadNotes,
+) -> Result<IndexedMesh, ReadError> {
+    notes.non_utf8_lines += text::non_utf8_lines(head);
     // Which element is which, and the plans: the vertex element's first, so a face
     // colour knows whether "colour" is taken whatever order the elements come in.
     let mut sides = Vec::with_capacity(header.elements.len());
@@ -752,13 +828,7 @@ pub(crate) fn read(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, R
         face_values: channels_of(Side::Face),
         triangle_faces: Vec::new(),
     };
-    let mut tok = Tokens::new(body, header.body_line);
-    let mut cur = Cursor {
-        data: body,
-        pos: 0,
-        base: header.body as u64,
-        big: header.encoding == Encoding::Big,
-    };
+    let big = header.encoding == Encoding::Big;
     for ((el, &side), plan) in header.elements.iter().zip(&sides).zip(&plans) {
         notes.skipped_properties += skipped(&plan.roles);
         let element = Reading {
@@ -766,9 +836,9 @@ pub(crate) fn read(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, R
             roles: &plan.roles,
             side,
         };
-        match header.encoding {
-            Encoding::Ascii => read_ascii_element(&mut tok, &element, &mut b)?,
-            Encoding::Little | Encoding::Big => read_binary_element(&mut cur, &element, &mut b)?,
+        match &mut body {
+            Body::Ascii(tok) => read_ascii_element(tok, &element, &mut b)?,
+            Body::Binary(input) => read_binary_element(input, &element, big, &mut b)?,
         }
         if side == Side::Vertex {
             b.vertex_count = Some(b.positions.len());
@@ -1022,128 +1092,262 @@ impl Cursor<'_> {
 }
 
 fn read_binary_element(
-    cur: &mut Cursor,
+    input: &mut Input<'_>,
     reading: &Reading,
+    big: bool,
+    b: &mut Builder,
+) -> Result<(), ReadError> {
+    let fixed: Option<usize> = reading
+        .el
+        .props
+        .iter()
+        .try_fold(0usize, |acc, (_, p)| match p {
+            Prop::Scalar(t) => Some(acc + t.size()),
+            Prop::List(..) => None,
+        });
+    match fixed {
+        Some(stride) => read_fixed(input, reading, stride, big, b),
+        None => read_variable(input, reading, big, b),
+    }
+}
+
+/// Reads an element whose records all take `stride` bytes, a window of whole records
+/// at a time.
+///
+/// The whole element must be in the data before any of its records is reported on (an
+/// element that does not fit is an error that names how many of its records do): a
+/// record's error is given only once the rest of the element is found to be there.
+fn read_fixed(
+    input: &mut Input<'_>,
+    reading: &Reading,
+    stride: usize,
+    big: bool,
     b: &mut Builder,
 ) -> Result<(), ReadError> {
     let Reading { el, roles, side } = *reading;
-    let what = plural(el.name);
-    let fixed: Option<usize> = el.props.iter().try_fold(0usize, |acc, (_, p)| match p {
-        Prop::Scalar(t) => Some(acc + t.size()),
-        Prop::List(..) => None,
-    });
-    if let Some(stride) = fixed {
-        // Fixed-size records: the whole element must fit in what is left.
-        let fits = cur.remaining() / stride.max(1);
-        if stride > 0 && fits < el.count {
-            let at = Location::Byte(cur.base + (cur.pos + fits * stride) as u64);
-            return Err(ReadError::truncated(
-                at,
-                format!("after {fits} of {} {what} (binary PLY)", el.count),
-            ));
-        }
-        if roles.iter().all(|r| matches!(r, Role::Skip)) {
-            cur.pos += stride * el.count;
-            return Ok(());
-        }
-        // The records fit, and each value takes at least a byte of them.
-        if roles.iter().any(|r| matches!(r, Role::Coord(_))) {
-            b.positions.reserve(el.count);
-        }
-        for v in b.values(side) {
-            v.data.reserve(el.count * v.dimension);
-        }
-    }
-    let mut has_faces = false;
-    for r in 0..el.count {
-        let truncated = |cur: &Cursor| {
-            ReadError::truncated(
-                cur.at(),
-                format!("after {r} of {} {what} (binary PLY)", el.count),
-            )
+    let start = input.offset();
+    let total = stride as u64 * el.count as u64;
+    let short = |end: u64| {
+        let fits = (end - start) / stride.max(1) as u64;
+        ReadError::truncated(
+            Location::Byte(start + fits * stride as u64),
+            format!(
+                "after {fits} of {} {} (binary PLY)",
+                el.count,
+                plural(el.name)
+            ),
+        )
+    };
+    if roles.iter().all(|r| matches!(r, Role::Skip)) {
+        let there = input.skip(total)?;
+        return if there < total {
+            Err(short(start + there))
+        } else {
+            Ok(())
         };
-        let record_at = cur.at();
-        b.start_record(side);
-        let mut p = [0.0; 3];
-        let mut is_vertex = false;
-        for (&(name, prop), &role) in el.props.iter().zip(roles) {
-            match (prop, role) {
-                (Prop::Scalar(ty), Role::Coord(k)) => {
-                    p[k] = cur.scalar(ty).ok_or_else(|| truncated(cur))?;
-                    is_vertex = true;
-                }
-                (
-                    Prop::Scalar(ty),
-                    Role::Value {
-                        channel,
-                        component,
-                        convert,
-                    },
-                ) => {
-                    let at = cur.at();
-                    let raw = cur.scalar(ty).ok_or_else(|| truncated(cur))?;
-                    let value = match convert {
-                        Convert::Float => raw as f32,
-                        Convert::Level(max) => from_level(raw, max),
+    }
+    // Each value takes at least a byte of its record.
+    let room = capacity_for(el.count, input.could_hold(), stride);
+    if roles.iter().any(|r| matches!(r, Role::Coord(_))) {
+        b.positions.reserve(room);
+    }
+    for v in b.values(side) {
+        v.data.reserve(room * v.dimension);
+    }
+    let mut r = 0;
+    while r < el.count {
+        input.fill(stride)?;
+        let window = input.window();
+        let n = (window.len() / stride).min(el.count - r);
+        if n == 0 {
+            // The data ends inside record r.
+            return Err(short(start + (r * stride) as u64));
+        }
+        let mut cur = Cursor {
+            data: &window[..n * stride],
+            pos: 0,
+            base: input.offset(),
+            big,
+        };
+        if let Err(e) = (r..r + n).try_for_each(|i| read_record(&mut cur, reading, i, b)) {
+            let rest = start + total - input.offset();
+            let there = input.skip(rest)?;
+            return Err(if there < rest {
+                short(input.offset())
+            } else {
+                e
+            });
+        }
+        input.consume(n * stride);
+        r += n;
+    }
+    Ok(())
+}
+
+/// Reads an element with list properties, a window of whole records at a time; at the
+/// end of the data, the window is all that is left, and reading an incomplete record
+/// from it gives the error that says what is missing.
+fn read_variable(
+    input: &mut Input<'_>,
+    reading: &Reading,
+    big: bool,
+    b: &mut Builder,
+) -> Result<(), ReadError> {
+    let el = reading.el;
+    if reading.roles.iter().any(|r| matches!(r, Role::Indices)) {
+        // At least 1 + 3 bytes per face: never reserve past the data.
+        b.triangles
+            .reserve(capacity_for(el.count, input.could_hold(), 4));
+    }
+    let mut r = 0;
+    while r < el.count {
+        let window = input.window();
+        let (mut n, mut len) = whole_records(window, &el.props, big, el.count - r);
+        if n == 0 {
+            if !input.at_end() {
+                let want = window.len() + 1;
+                input.fill(want)?;
+                continue;
+            }
+            (n, len) = (1, window.len());
+        }
+        let mut cur = Cursor {
+            data: &window[..len],
+            pos: 0,
+            base: input.offset(),
+            big,
+        };
+        (r..r + n).try_for_each(|i| read_record(&mut cur, reading, i, b))?;
+        input.consume(len);
+        r += n;
+    }
+    Ok(())
+}
+
+/// How many whole records of an element with `props` start `data` (at most `max`),
+/// and how many bytes they take. A record with a negative list length counts as whole
+/// up to that length, where its reading stops with an error.
+fn whole_records(data: &[u8], props: &[(&[u8], Prop)], big: bool, max: usize) -> (usize, usize) {
+    let (mut n, mut len) = (0, 0);
+    while n < max {
+        let mut cur = Cursor {
+            data,
+            pos: len,
+            base: 0,
+            big,
+        };
+        for &(_, prop) in props {
+            match prop {
+                Prop::Scalar(ty) => cur.pos += ty.size(),
+                Prop::List(ct, it) => {
+                    let Some(count) = cur.int(ct) else {
+                        return (n, len);
                     };
-                    b.store(
-                        side,
-                        (channel, component),
-                        value,
-                        (el.name, r, name),
-                        || format!("{raw:e}"),
-                        at,
-                    )?;
+                    let Ok(count) = usize::try_from(count) else {
+                        return (n + 1, cur.pos);
+                    };
+                    cur.pos = cur.pos.saturating_add(count.saturating_mul(it.size()));
                 }
-                (Prop::Scalar(ty), _) => {
-                    if cur.remaining() < ty.size() {
-                        return Err(truncated(cur));
-                    }
-                    cur.pos += ty.size();
+            }
+            if cur.pos > data.len() {
+                return (n, len);
+            }
+        }
+        (n, len) = (n + 1, cur.pos);
+    }
+    (n, len)
+}
+
+/// Reads record `r` of an element from `cur`, which holds it whole unless the data
+/// ends inside it.
+fn read_record(
+    cur: &mut Cursor,
+    reading: &Reading,
+    r: usize,
+    b: &mut Builder,
+) -> Result<(), ReadError> {
+    let Reading { el, roles, side } = *reading;
+    let truncated = |cur: &Cursor| {
+        ReadError::truncated(
+            cur.at(),
+            format!("after {r} of {} {} (binary PLY)", el.count, plural(el.name)),
+        )
+    };
+    let record_at = cur.at();
+    b.start_record(side);
+    let mut p = [0.0; 3];
+    let mut is_vertex = false;
+    for (&(name, prop), &role) in el.props.iter().zip(roles) {
+        match (prop, role) {
+            (Prop::Scalar(ty), Role::Coord(k)) => {
+                p[k] = cur.scalar(ty).ok_or_else(|| truncated(cur))?;
+                is_vertex = true;
+            }
+            (
+                Prop::Scalar(ty),
+                Role::Value {
+                    channel,
+                    component,
+                    convert,
+                },
+            ) => {
+                let at = cur.at();
+                let raw = cur.scalar(ty).ok_or_else(|| truncated(cur))?;
+                let value = match convert {
+                    Convert::Float => raw as f32,
+                    Convert::Level(max) => from_level(raw, max),
+                };
+                b.store(
+                    side,
+                    (channel, component),
+                    value,
+                    (el.name, r, name),
+                    || format!("{raw:e}"),
+                    at,
+                )?;
+            }
+            (Prop::Scalar(ty), _) => {
+                if cur.remaining() < ty.size() {
+                    return Err(truncated(cur));
                 }
-                (Prop::List(ct, it), role) => {
-                    let list_at = cur.at();
-                    let n = cur.int(ct).ok_or_else(|| truncated(cur))?;
-                    let n = u64::try_from(n).map_err(|_| {
-                        ReadError::malformed(
-                            list_at,
-                            format!("{} {r}: negative list length {n}", el.name.escape_ascii()),
-                        )
-                    })?;
-                    let bytes = n.saturating_mul(it.size() as u64);
-                    if bytes > cur.remaining() as u64 {
-                        return Err(ReadError::truncated(
-                            list_at,
-                            format!(
-                                "in {} {r}: its list claims {n} items ({bytes} bytes) but \
-                                 only {} bytes are left",
-                                el.name.escape_ascii(),
-                                cur.remaining()
-                            ),
-                        ));
+                cur.pos += ty.size();
+            }
+            (Prop::List(ct, it), role) => {
+                let list_at = cur.at();
+                let n = cur.int(ct).ok_or_else(|| truncated(cur))?;
+                let n = u64::try_from(n).map_err(|_| {
+                    ReadError::malformed(
+                        list_at,
+                        format!("{} {r}: negative list length {n}", el.name.escape_ascii()),
+                    )
+                })?;
+                let bytes = n.saturating_mul(it.size() as u64);
+                if bytes > cur.remaining() as u64 {
+                    return Err(ReadError::truncated(
+                        list_at,
+                        format!(
+                            "in {} {r}: its list claims {n} items ({bytes} bytes) but \
+                             only {} bytes are left",
+                            el.name.escape_ascii(),
+                            cur.remaining()
+                        ),
+                    ));
+                }
+                if let Role::Indices = role {
+                    for _ in 0..n {
+                        let at = cur.at();
+                        let i = cur.int(it).ok_or_else(|| truncated(cur))?;
+                        b.push_index(i, at)?;
                     }
-                    if let Role::Indices = role {
-                        if !has_faces {
-                            // At least 1 + 3 bytes per face: never reserve past the data.
-                            b.triangles
-                                .reserve(capacity_for(el.count, cur.remaining(), 4));
-                            has_faces = true;
-                        }
-                        for _ in 0..n {
-                            let at = cur.at();
-                            let i = cur.int(it).ok_or_else(|| truncated(cur))?;
-                            b.push_index(i, at)?;
-                        }
-                        b.end_face(record_at)?;
-                    } else {
-                        cur.pos += bytes as usize;
-                    }
+                    b.end_face(record_at)?;
+                } else {
+                    cur.pos += bytes as usize;
                 }
             }
         }
-        if is_vertex {
-            b.push_vertex(p, record_at)?;
-        }
+    }
+    if is_vertex {
+        b.push_vertex(p, record_at)?;
     }
     Ok(())
 }

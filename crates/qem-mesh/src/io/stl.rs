@@ -14,82 +14,161 @@
 
 use std::io::Write;
 
-use super::text::{parse_f64, show, Tokens};
+use super::input::Input;
+use super::text::{self, capacity_for, parse_f64, show, Tokens};
 use super::{sniff, strip_bom, Format, Location, ReadError, ReadNotes};
 use crate::{IndexedMesh, InputError, MAX_ELEMENTS};
 
 const HEADER: usize = 84;
 const RECORD: usize = 50;
 
-pub(crate) fn read(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, ReadError> {
+/// What the start of the data must hold for [`sniff`] and the NUL test below to see
+/// what they would see in the whole data: a byte order mark and 4096 bytes.
+const START: usize = 3 + 4096;
+
+/// Reads an STL file: binary STL as it arrives, ASCII STL from all its bytes at once.
+pub(crate) fn read(input: &mut Input<'_>, notes: &mut ReadNotes) -> Result<IndexedMesh, ReadError> {
+    input.fill(START)?;
+    let window = input.window();
+    let (text, _) = strip_bom(window);
+    // `sniff` looks past the first 4096 bytes only to skip leading whitespace.
+    let decided = input.at_end() || text::trim_start(text).len() >= 5;
+    let count = window
+        .get(80..84)
+        .and_then(|b| b.try_into().ok())
+        .map(u32::from_le_bytes);
+    let looks_like = sniff(text);
+    match count {
+        Some(n) if decided && !is_text(looks_like, text) => read_binary(input, n, looks_like),
+        _ => read_all(&input.rest()?, notes),
+    }
+}
+
+/// Whether data that `looks_like` this and starts with `text` is read as ASCII STL
+/// (when its size does not say it is binary).
+fn is_text(looks_like: Option<&str>, text: &[u8]) -> bool {
+    looks_like == Some("an ASCII STL file") && !text[..text.len().min(1024)].contains(&0)
+}
+
+/// Reads an STL file from all its bytes.
+fn read_all(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, ReadError> {
     let count = bytes
         .get(80..84)
         .and_then(|b| b.try_into().ok())
         .map(u32::from_le_bytes);
-    if let Some(n) = count {
-        if (n as u64) * (RECORD as u64) + HEADER as u64 == bytes.len() as u64 {
-            return read_binary(bytes, n as usize);
-        }
-    }
-    // Not binary by size: a byte order mark can only be text's.
     let (text, bom) = strip_bom(bytes);
     let looks_like = sniff(text);
-    let head = &text[..text.len().min(1024)];
-    let textual = !head.contains(&0);
-    if looks_like == Some("an ASCII STL file") && textual {
-        notes.byte_order_mark = bom;
-        notes.non_utf8_lines += super::text::non_utf8_lines(text);
-        return read_ascii(text, notes);
-    }
-    match (count, looks_like) {
-        (Some(n), None | Some("an ASCII STL file") | Some("binary data")) => {
-            // Not ASCII: a binary STL whose size disagrees with its count.
-            let expected = n as u64 * RECORD as u64 + HEADER as u64;
-            if n as u64 > MAX_ELEMENTS as u64 {
-                return Err(ReadError::too_large(
-                    Location::Byte(80),
-                    "binary STL header claims triangles:",
-                    n as u64,
-                ));
-            }
-            if (bytes.len() as u64) < expected {
-                let done = (bytes.len() - HEADER) / RECORD;
-                Err(ReadError::truncated(
-                    Location::Byte(bytes.len() as u64),
-                    format!("after {done} of {n} triangles (binary STL of {expected} bytes)"),
-                ))
-            } else {
-                Err(ReadError::not_this_format(
-                    Format::Stl,
-                    looks_like.filter(|&l| l != "binary data"),
-                    format!(
-                        "binary STL header claims {n} triangles ({expected} bytes) \
-                         but there are {} bytes",
-                        bytes.len()
-                    ),
-                ))
-            }
+    match count {
+        Some(n) if expected_len(n) == bytes.len() as u64 || !is_text(looks_like, text) => {
+            read_binary(&mut Input::plain(bytes), n, looks_like)
         }
-        _ => Err(ReadError::not_this_format(
-            Format::Stl,
-            looks_like,
-            "neither ASCII (\"solid ...\") nor binary (84 + 50 bytes per triangle)",
-        )),
+        _ if is_text(looks_like, text) => {
+            notes.byte_order_mark = bom;
+            notes.non_utf8_lines += super::text::non_utf8_lines(text);
+            read_ascii(text, notes)
+        }
+        _ => Err(not_stl(looks_like)),
     }
 }
 
-fn read_binary(bytes: &[u8], n: usize) -> Result<IndexedMesh, ReadError> {
-    if n > MAX_ELEMENTS {
+/// The size of a binary STL file of `n` triangles.
+fn expected_len(n: u32) -> u64 {
+    u64::from(n) * RECORD as u64 + HEADER as u64
+}
+
+/// The error for data that is neither ASCII nor binary STL.
+fn not_stl(looks_like: Option<&'static str>) -> ReadError {
+    ReadError::not_this_format(
+        Format::Stl,
+        looks_like,
+        "neither ASCII (\"solid ...\") nor binary (84 + 50 bytes per triangle)",
+    )
+}
+
+/// Reads data that is binary STL if its size is `84 + 50·n` bytes, `n` being the count
+/// at byte 80, and otherwise an error (`looks_like` is what its start looks like).
+/// Facets are read as they arrive; the size is known at the end of the data, and
+/// decides whether what was read is the result.
+fn read_binary(
+    input: &mut Input<'_>,
+    n: u32,
+    looks_like: Option<&'static str>,
+) -> Result<IndexedMesh, ReadError> {
+    let too_large = n as usize > MAX_ELEMENTS;
+    let count = if too_large { 0 } else { n as usize };
+    input.consume(HEADER);
+    let room = capacity_for(count, input.could_hold(), RECORD);
+    let mut positions = Vec::with_capacity(3 * room);
+    let mut triangles = Vec::with_capacity(room);
+    // The first facet with a coordinate that is not finite: reported only once the
+    // size says the data is binary STL.
+    let mut bad = None;
+    let mut t = 0;
+    while t < count {
+        input.fill(RECORD)?;
+        let window = input.window();
+        let k = (window.len() / RECORD).min(count - t);
+        if k == 0 {
+            break;
+        }
+        if bad.is_none() {
+            let at = input.offset();
+            bad = read_facets(&window[..k * RECORD], at, &mut positions, &mut triangles);
+        }
+        input.consume(k * RECORD);
+        t += k;
+    }
+    let len = input.offset() + input.skip(u64::MAX)?;
+    if len == expected_len(n) && !too_large {
+        return match bad {
+            Some(e) => Err(e),
+            None => Ok(IndexedMesh::new(positions, triangles)),
+        };
+    }
+    let binary_error = matches!(
+        looks_like,
+        None | Some("an ASCII STL file") | Some("binary data")
+    );
+    if too_large && (binary_error || len == expected_len(n)) {
         return Err(ReadError::too_large(
             Location::Byte(80),
             "binary STL header claims triangles:",
             n as u64,
         ));
     }
-    let body = bytes.get(HEADER..).unwrap_or_default();
-    let mut positions = Vec::with_capacity(3 * n);
-    let mut triangles = Vec::with_capacity(n);
-    for (t, rec) in body.chunks_exact(RECORD).enumerate() {
+    if !binary_error {
+        return Err(not_stl(looks_like));
+    }
+    // Not ASCII: a binary STL whose size disagrees with its count.
+    let expected = expected_len(n);
+    if len < expected {
+        let done = (len - HEADER as u64) / RECORD as u64;
+        Err(ReadError::truncated(
+            Location::Byte(len),
+            format!("after {done} of {n} triangles (binary STL of {expected} bytes)"),
+        ))
+    } else {
+        Err(ReadError::not_this_format(
+            Format::Stl,
+            looks_like.filter(|&l| l != "binary data"),
+            format!(
+                "binary STL header claims {n} triangles ({expected} bytes) \
+                 but there are {len} bytes"
+            ),
+        ))
+    }
+}
+
+/// Appends the facets of whole records `data`, which start at byte `at` of the data;
+/// stops at the first vertex with a coordinate that is not finite, and gives its
+/// error.
+fn read_facets(
+    data: &[u8],
+    at: u64,
+    positions: &mut Vec<[f64; 3]>,
+    triangles: &mut Vec<[u32; 3]>,
+) -> Option<ReadError> {
+    for (r, rec) in data.chunks_exact(RECORD).enumerate() {
         for k in 0..3 {
             let mut p = [0.0f64; 3];
             for (c, slot) in p.iter_mut().enumerate() {
@@ -102,8 +181,8 @@ fn read_binary(bytes: &[u8], n: usize) -> Result<IndexedMesh, ReadError> {
                 *slot = f64::from(raw);
             }
             if !p.iter().all(|c| c.is_finite()) {
-                return Err(ReadError::mesh(
-                    Some(Location::Byte((HEADER + t * RECORD + 12 + 12 * k) as u64)),
+                return Some(ReadError::mesh(
+                    Some(Location::Byte(at + (r * RECORD + 12 + 12 * k) as u64)),
                     InputError::NonFiniteCoordinate {
                         vertex: positions.len(),
                     },
@@ -111,10 +190,11 @@ fn read_binary(bytes: &[u8], n: usize) -> Result<IndexedMesh, ReadError> {
             }
             positions.push(p);
         }
-        let b = (3 * t) as u32;
+        // Fewer than 2^28 triangles (MAX_ELEMENTS), so 3t + 2 fits a u32.
+        let b = (3 * triangles.len()) as u32;
         triangles.push([b, b + 1, b + 2]);
     }
-    Ok(IndexedMesh::new(positions, triangles))
+    None
 }
 
 fn read_ascii(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, ReadError> {

@@ -29,6 +29,8 @@ mod io_corpus;
 mod io_errors;
 #[cfg(feature = "io")]
 mod io_lenient;
+#[cfg(feature = "io")]
+mod io_streaming;
 mod ladder;
 mod measure;
 mod numeric_extremes;
