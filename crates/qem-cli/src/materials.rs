@@ -7,11 +7,14 @@
 //! simplified copy written to another directory would open grey.
 //!
 //! Nothing the user has is overwritten: a file of that name already beside the output
-//! is kept (and reported when it differs). Names that would leave the output's
-//! directory (absolute, or with `..`) are not followed. A file that cannot be copied is
-//! a note in the report, never a failed run: the mesh itself was written.
+//! (or one that appears while the copy is made) is kept, and reported when it differs.
+//! Names that would leave the output's directory (absolute, or with `..`) are not
+//! followed, nor links beside the input to files outside its directory. A file that
+//! cannot be copied is a note in the report, never a failed run: the mesh itself was
+//! written. Known limits: a texture name with spaces is taken as its last word, and
+//! names are taken as UTF-8 text with `/` between directories.
 
-use qem_mesh::io::write_atomically;
+use qem_mesh::io::write_new_atomically;
 use serde::Serialize;
 use std::collections::BTreeSet;
 use std::path::{Component, Path, PathBuf};
@@ -138,8 +141,9 @@ fn relative_to_library(library: &str, texture: &str) -> String {
     }
 }
 
-/// Copies `name` from `from` to `to`; whether the file is beside the output now
-/// (copied, or there already).
+/// Copies `name` from `from` to `to`; whether the file beside the output is the
+/// input's (copied, or there already with the same bytes), so that what it names
+/// should follow it.
 fn copy_one(from: &Path, to: &Path, name: &str, json: &mut MaterialFilesJson) -> bool {
     let relative = Path::new(name);
     let stays_inside = !name.is_empty()
@@ -155,16 +159,26 @@ fn copy_one(from: &Path, to: &Path, name: &str, json: &mut MaterialFilesJson) ->
         json.not_copied(name, "not found beside the input");
         return false;
     }
-    if target.exists() {
-        if same_bytes(&source, &target) {
-            json.already_there.push(name.to_string());
-            return true;
+    // A link beside the input may point anywhere (a key, another user's file); only
+    // what really lies below the input's directory is copied.
+    let inside = match (from.canonicalize(), source.canonicalize()) {
+        (Ok(root), Ok(real)) => real.starts_with(root),
+        _ => false,
+    };
+    if !inside {
+        json.not_copied(name, "it links to a file outside the input's directory");
+        return false;
+    }
+    let mut file = match std::fs::File::open(&source) {
+        Ok(file) => file,
+        Err(e) => {
+            json.not_copied(name, &format!("cannot read it: {e}"));
+            return false;
         }
-        json.not_copied(
-            name,
-            "a different file of that name is beside the output; kept it",
-        );
-        return true;
+    };
+    // (A dangling link is something there too: it is the user's, and kept.)
+    if std::fs::symlink_metadata(&target).is_ok() {
+        return kept_or_same(&source, &target, name, json);
     }
     if let Some(dir) = target.parent() {
         if let Err(e) = std::fs::create_dir_all(dir) {
@@ -172,15 +186,14 @@ fn copy_one(from: &Path, to: &Path, name: &str, json: &mut MaterialFilesJson) ->
             return false;
         }
     }
-    let copied = write_atomically(&target, |file| {
-        let mut source = std::fs::File::open(&source)?;
-        std::io::copy(&mut source, file).map(|_| ())
-    });
-    match copied {
-        Ok(()) => {
+    // Published only if nothing took the name meanwhile (another job of a batch
+    // copying a texture of the same name, say).
+    match write_new_atomically(&target, |out| std::io::copy(&mut file, out).map(|_| ())) {
+        Ok(true) => {
             json.copied.push(name.to_string());
             true
         }
+        Ok(false) => kept_or_same(&source, &target, name, json),
         Err(e) => {
             json.not_copied(name, &e.to_string());
             false
@@ -188,13 +201,46 @@ fn copy_one(from: &Path, to: &Path, name: &str, json: &mut MaterialFilesJson) ->
     }
 }
 
-/// Whether two files hold the same bytes (false when either cannot be read).
+/// For a file already beside the output: `already_there` when it has the input's
+/// bytes (true), `not_copied` when it differs (false: what the input's file names is
+/// not followed either, since the file there may name other things).
+fn kept_or_same(source: &Path, target: &Path, name: &str, json: &mut MaterialFilesJson) -> bool {
+    if same_bytes(source, target) {
+        json.already_there.push(name.to_string());
+        true
+    } else {
+        json.not_copied(
+            name,
+            "a different file of that name is beside the output; kept it",
+        );
+        false
+    }
+}
+
+/// Whether two files hold the same bytes (false when either cannot be read), compared
+/// a block at a time.
 fn same_bytes(a: &Path, b: &Path) -> bool {
+    use std::io::Read;
     let size = |p: &Path| std::fs::metadata(p).map(|m| m.len()).ok();
     if size(a).is_none() || size(a) != size(b) {
         return false;
     }
-    matches!((std::fs::read(a), std::fs::read(b)), (Ok(x), Ok(y)) if x == y)
+    let (Ok(a), Ok(b)) = (std::fs::File::open(a), std::fs::File::open(b)) else {
+        return false;
+    };
+    let (mut a, mut b) = (std::io::BufReader::new(a), std::io::BufReader::new(b));
+    let (mut x, mut y) = (vec![0u8; 1 << 16], vec![0u8; 1 << 16]);
+    loop {
+        let Ok(n) = a.read(&mut x) else {
+            return false;
+        };
+        if n == 0 {
+            return b.read(&mut y[..1]).is_ok_and(|m| m == 0);
+        }
+        if b.read_exact(&mut y[..n]).is_err() || x[..n] != y[..n] {
+            return false;
+        }
+    }
 }
 
 /// The texture files a material library names (the last word of each texture

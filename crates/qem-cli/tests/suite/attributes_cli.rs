@@ -162,3 +162,54 @@ fn attribute_weights_change_the_result_and_bad_ones_are_refused() {
         stderr(&o)
     );
 }
+
+/// A link beside the input to a file outside its directory is not copied (a texture
+/// that links to a key would otherwise land, as a plain file, beside the output); a
+/// link that stays inside is, and an output beside its input copies nothing.
+#[cfg(unix)]
+#[test]
+fn material_files_do_not_follow_links_out_of_the_input_directory() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, out) = (dir.path().join("in"), dir.path().join("out"));
+    std::fs::create_dir_all(&input).unwrap();
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::copy(spot(), input.join("m.obj")).unwrap();
+    std::fs::write(
+        input.join("spot.mtl"),
+        "newmtl spot\nmap_Kd secret.png\nmap_Ks inside.png\n",
+    )
+    .unwrap();
+    std::fs::write(dir.path().join("secret"), b"a key").unwrap();
+    std::os::unix::fs::symlink(dir.path().join("secret"), input.join("secret.png")).unwrap();
+    std::fs::write(input.join("real.png"), b"texture").unwrap();
+    std::os::unix::fs::symlink(input.join("real.png"), input.join("inside.png")).unwrap();
+    let report = out.join("r.json");
+    let run = |output: &std::path::Path| {
+        crate::common::qem(&[
+            "simplify",
+            crate::common::s(&input.join("m.obj")),
+            "-o",
+            crate::common::s(output),
+            "--ratio",
+            "0.5",
+            "--report",
+            crate::common::s(&report),
+        ])
+    };
+    let o = run(&out.join("m.obj"));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let files = &crate::common::json(&report)["material_files"];
+    assert_eq!(
+        files["copied"],
+        serde_json::json!(["spot.mtl", "inside.png"])
+    );
+    assert_eq!(files["not_copied"][0]["file"], "secret.png");
+    assert!(!out.join("secret.png").exists());
+    assert_eq!(std::fs::read(out.join("inside.png")).unwrap(), b"texture");
+    // Beside its input: nothing to copy.
+    let o = run(&input.join("m-10.obj"));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let files = &crate::common::json(&report)["material_files"];
+    assert_eq!(files["copied"], serde_json::json!([]));
+    assert_eq!(files["not_copied"], serde_json::json!([]));
+}

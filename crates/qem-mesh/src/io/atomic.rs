@@ -45,6 +45,49 @@ pub fn write_atomically(
     path: &Path,
     write: impl FnOnce(&mut File) -> std::io::Result<()>,
 ) -> Result<(), IoError> {
+    write_then(path, write, |tmp| std::fs::rename(tmp, path)).map(|_| ())
+}
+
+/// [`write_atomically`], but never over a file that is there: the complete file is
+/// published under `path` only if nothing has that name (a link, not a rename, so that
+/// a writer racing for the name cannot be overwritten either). `Ok(false)` when
+/// something had the name; the temporary file is removed either way.
+///
+/// ```
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// use std::io::Write;
+/// let dir = tempfile::tempdir()?;
+/// let path = dir.path().join("texture.png");
+/// assert!(qem_mesh::io::write_new_atomically(&path, |f| f.write_all(b"first"))?);
+/// assert!(!qem_mesh::io::write_new_atomically(&path, |f| f.write_all(b"second"))?);
+/// assert_eq!(std::fs::read(&path)?, b"first");
+/// # Ok(()) }
+/// ```
+pub fn write_new_atomically(
+    path: &Path,
+    write: impl FnOnce(&mut File) -> std::io::Result<()>,
+) -> Result<bool, IoError> {
+    write_then(path, write, |tmp| {
+        let published = match std::fs::hard_link(tmp, path) {
+            Ok(()) => Ok(true),
+            Err(e) if e.kind() == ErrorKind::AlreadyExists => Ok(false),
+            // A file system without links: checked, then renamed (a race with
+            // another writer of the same name is possible there, and only there).
+            Err(_) if std::fs::symlink_metadata(path).is_ok() => Ok(false),
+            Err(_) => return std::fs::rename(tmp, path).map(|()| true),
+        };
+        std::fs::remove_file(tmp)?;
+        published
+    })
+}
+
+/// Writes a temporary file beside `path` with `write`, flushes it, and hands it to
+/// `publish`; removes it when any step fails.
+fn write_then<T>(
+    path: &Path,
+    write: impl FnOnce(&mut File) -> std::io::Result<()>,
+    publish: impl FnOnce(&Path) -> std::io::Result<T>,
+) -> Result<T, IoError> {
     let fail = |source: std::io::Error| IoError::File {
         path: path.to_path_buf(),
         action: write_action(source.kind()),
@@ -55,7 +98,7 @@ pub fn write_atomically(
         .and_then(|()| file.sync_all())
         .and_then(|()| {
             drop(file);
-            std::fs::rename(&tmp, path)
+            publish(&tmp)
         })
         .map_err(fail);
     if result.is_err() {

@@ -92,8 +92,8 @@ use std::io::{Read, Write};
 use std::path::Path;
 
 pub use atomic::{
-    remove_stale_temporaries, temporary_owner, write_atomically, STALE_AGE_WITHOUT_PROC,
-    TEMP_MARKER,
+    remove_stale_temporaries, temporary_owner, write_atomically, write_new_atomically,
+    STALE_AGE_WITHOUT_PROC, TEMP_MARKER,
 };
 pub use error::{IoError, Location, ReadError, ReadErrorKind};
 use input::Input;

@@ -256,10 +256,9 @@ impl TriangleBvh {
     /// through `to_index` first (which should be cheap: it runs several times per
     /// corner), and where each triangle went (as [`with_slots`](Self::with_slots)).
     ///
-    /// Why from the mesh rather than a list of corners: the corners are gathered
-    /// straight into leaf order once the tree's order is known (on both cores), where a
-    /// list would be gathered first (on one) and then permuted in place. On a
-    /// 4M-triangle mesh that is 288 MB written once instead of twice.
+    /// Why from the mesh rather than a list of corners: the index keeps each shared
+    /// vertex once (`CornerStore`), numbered in leaf order once the tree's order
+    /// is known, where a list would hold every corner three times over first.
     pub fn from_triangles(
         mesh: &IndexedMesh,
         to_index: impl Fn(P3) -> P3 + Sync,
@@ -569,8 +568,8 @@ impl TriangleBvh {
 /// went, the root's box, and the pieces' triangles (when there are pieces).
 type Built = (Vec<WideNode>, CornerStore, Vec<u32>, Aabb, Option<Vec<u32>>);
 
-/// The tree over the `count` triangles whose corners `corners_of` gives (those
-/// corners returned in leaf order, see [`TriangleBvh::corners`]), node 0 the root,
+/// The tree over the triangles of `source` (their corners returned in leaf order, see
+/// [`TriangleBvh::corners`]), node 0 the root,
 /// every node after its parent; where each triangle went (`slots[i]` is the
 /// new index of the triangle that was at `i`); the box of all the corners; and the
 /// triangle of each leaf entry when some triangle is indexed in pieces (see
@@ -584,8 +583,9 @@ type Built = (Vec<WideNode>, CornerStore, Vec<u32>, Aabb, Option<Vec<u32>>);
 /// holds a binary node per range (56 bytes each, about 134 MB on the 4M sphere).
 ///
 /// Four steps, so that none reads corners out of order: [`partition`] puts every
-/// entry in its leaf (on both cores), the corners are gathered in leaf order (on both
-/// cores), [`wide_nodes`] lays out the nodes (which needs only the range sizes), and
+/// entry in its leaf (on both cores), the corners are gathered in leaf order (points
+/// numbered on one core, then fetched on both: [`CornerStore::gather`]), [`wide_nodes`]
+/// lays out the nodes (which needs only the range sizes), and
 /// [`fill_boxes`] fills in the boxes bottom-up. Why: building top-down with each
 /// range's box computed as its split was made read every triangle's 72 bytes of
 /// corners at random, once per level; that was most of the index build, then the

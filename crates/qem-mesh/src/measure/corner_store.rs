@@ -44,6 +44,8 @@ impl CornerStore {
             triangles.push(points_of(t).map(|v| {
                 let slot = &mut number[v as usize];
                 if *slot == UNNUMBERED {
+                    // (Callers number at most u32::MAX / 3 triangles' points.)
+                    debug_assert!(old.len() < UNNUMBERED as usize);
                     *slot = old.len() as u32;
                     old.push(v);
                 }

@@ -41,6 +41,11 @@ impl Engine {
             .filter(|(_, step)| !options.strict && step.allowed(options))
             .collect();
         let climbable: Vec<RelaxationStep> = steps.iter().map(|&(_, step)| step).collect();
+        // The greedy order dropped the pairs the last level put off (a level that
+        // landed on its target never asked them again): queued again for this one.
+        if self.ladder.put_off_past_target {
+            self.retry(options.order);
+        }
         self.ladder.may_pass_target = false;
         self.ladder.put_off_past_target = false;
         let mut reason = self.run_landing(options.order, target, observer);
@@ -97,10 +102,13 @@ impl Engine {
         observer: &mut dyn Observer,
     ) -> StopReason {
         let reason = self.run_order(order, target, observer);
-        if reason != StopReason::NoValidPair
-            || !self.ladder.put_off_past_target
-            || self.ladder.may_pass_target
-        {
+        // Also after an error bound: the pairs put off were cheaper than the one over
+        // it, and may be within it.
+        let short = matches!(
+            reason,
+            StopReason::NoValidPair | StopReason::MaxErrorReached
+        );
+        if !short || !self.ladder.put_off_past_target || self.ladder.may_pass_target {
             return reason;
         }
         self.ladder.may_pass_target = true;
