@@ -6,6 +6,7 @@
 
 use std::io::Write;
 
+use crate::common::grid;
 use qem_mesh::io::{read_bytes, read_path, write_to, Format, LoadedMesh};
 use qem_mesh::IndexedMesh;
 
@@ -69,25 +70,10 @@ fn body(ply: &[u8]) -> usize {
     ply.windows(11).position(|w| w == b"end_header\n").unwrap() + 11
 }
 
-/// A grid of `n` x `n` vertices: large enough that records straddle the 1 MiB chunks.
-fn grid(n: u32) -> IndexedMesh {
-    let positions = (0..n * n)
-        .map(|i| [f64::from(i % n), f64::from(i / n), f64::from(i % 7) * 0.1])
-        .collect();
-    let mut triangles = Vec::new();
-    for y in 0..n - 1 {
-        for x in 0..n - 1 {
-            let a = y * n + x;
-            triangles.push([a, a + 1, a + n]);
-            triangles.push([a + 1, a + n + 1, a + n]);
-        }
-    }
-    IndexedMesh::new(positions, triangles)
-}
-
 #[test]
 fn files_of_several_chunks_read_back_exactly() {
-    let mesh = grid(400);
+    // 400 x 400 vertices: large enough that records straddle the 1 MiB chunks.
+    let mesh = grid(399, 399, 0.3);
     for (name, format) in [("grid.ply", Format::Ply), ("grid.stl", Format::Stl)] {
         let data = encode(&mesh, format);
         assert!(data.len() > 3 << 20, "{name} spans several chunks");
