@@ -11,8 +11,8 @@
 //! Names that would leave the output's directory (absolute, or with `..`) are not
 //! followed, nor links beside the input to files outside its directory. A file that
 //! cannot be copied is a note in the report, never a failed run: the mesh itself was
-//! written. Known limits: a texture name with spaces is taken as its last word, and
-//! names are taken as UTF-8 text with `/` between directories.
+//! written. Texture names may hold spaces; `\` between directories (Windows
+//! exporters) is read as `/`; names must be UTF-8 text.
 
 use qem_mesh::io::write_new_atomically;
 use serde::Serialize;
@@ -243,8 +243,9 @@ fn same_bytes(a: &Path, b: &Path) -> bool {
     }
 }
 
-/// The texture files a material library names (the last word of each texture
-/// statement, after its options), in order, each once.
+/// The texture files a material library names (what follows each texture statement's
+/// options, spaces included), in order, each once; Windows' `\` between directories
+/// read as `/`.
 fn textures_of(library: &Path) -> Vec<String> {
     let Ok(meta) = std::fs::metadata(library) else {
         return Vec::new();
@@ -258,20 +259,54 @@ fn textures_of(library: &Path) -> Vec<String> {
     let text = String::from_utf8_lossy(&bytes);
     let mut names: Vec<String> = Vec::new();
     for line in text.lines() {
-        let mut words = line.split_ascii_whitespace();
-        let Some(statement) = words.next() else {
+        let Some(file) = texture_of(line) else {
             continue;
         };
-        if !TEXTURE_STATEMENTS.contains(&statement.to_ascii_lowercase().as_str()) {
-            continue;
-        }
-        if let Some(file) = words.last() {
-            if !names.iter().any(|n| n == file) {
-                names.push(file.to_string());
-            }
+        let file = file.replace('\\', "/");
+        if !names.contains(&file) {
+            names.push(file);
         }
     }
     names
+}
+
+/// The file a texture statement names: the rest of the line after the statement and
+/// its options (MTL's `-o u v w`, `-bm 0.5`, `-clamp on`...), trimmed; `None` for any
+/// other line.
+fn texture_of(line: &str) -> Option<&str> {
+    let line = line.trim();
+    let (statement, mut rest) = line.split_once(|c: char| c.is_ascii_whitespace())?;
+    if !TEXTURE_STATEMENTS.contains(&statement.to_ascii_lowercase().as_str()) {
+        return None;
+    }
+    loop {
+        rest = rest.trim_start();
+        let (word, after) = rest
+            .split_once(|c: char| c.is_ascii_whitespace())
+            .unwrap_or((rest, ""));
+        // Options and how many values follow each (`-o`, `-s` and `-t` take one to
+        // three numbers).
+        let values = match word {
+            "-blendu" | "-blendv" | "-bm" | "-boost" | "-cc" | "-clamp" | "-imfchan"
+            | "-texres" | "-type" => 1..=1,
+            "-mm" => 2..=2,
+            "-o" | "-s" | "-t" => 1..=3,
+            _ => break,
+        };
+        rest = after;
+        for taken in 1..=*values.end() {
+            rest = rest.trim_start();
+            let (value, after) = rest
+                .split_once(|c: char| c.is_ascii_whitespace())
+                .unwrap_or((rest, ""));
+            if taken > *values.start() && value.parse::<f64>().is_err() {
+                break;
+            }
+            rest = after;
+        }
+    }
+    let file = rest.trim();
+    (!file.is_empty()).then_some(file)
 }
 
 #[cfg(test)]
@@ -279,7 +314,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn texture_statements_give_their_last_word() {
+    fn texture_statements_give_the_file_after_their_options() {
         let dir = tempfile::tempdir().unwrap();
         let mtl = dir.path().join("m.mtl");
         std::fs::write(
@@ -289,6 +324,32 @@ mod tests {
         )
         .unwrap();
         assert_eq!(textures_of(&mtl), ["tex/a.png", "b.png", "n.png"]);
+    }
+
+    #[test]
+    fn texture_names_keep_their_spaces_and_lose_windows_separators() {
+        for (line, name) in [
+            ("map_Kd my texture.png", Some("my texture.png")),
+            (
+                "map_Kd -o 0.5 0.5 -s 2 2 2 wood grain.jpg",
+                Some("wood grain.jpg"),
+            ),
+            ("map_Kd -o 1 tex.png", Some("tex.png")),
+            ("map_Kd -mm 0 1 -clamp on a.png", Some("a.png")),
+            (
+                "  map_bump -bm 0.3   textures\\n.png ",
+                Some("textures\\n.png"),
+            ),
+            ("Kd 1 1 1", None),
+            ("map_Kd", None),
+            ("map_Kd -clamp on", None),
+        ] {
+            assert_eq!(texture_of(line), name, "{line}");
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let mtl = dir.path().join("m.mtl");
+        std::fs::write(&mtl, "map_Kd textures\\wood.jpg\n").unwrap();
+        assert_eq!(textures_of(&mtl), ["textures/wood.jpg"]);
     }
 
     #[test]
