@@ -14,10 +14,10 @@
 //! written. Texture names may hold spaces; `\` between directories (Windows
 //! exporters) is read as `/`; names must be UTF-8 text.
 
-use qem_mesh::io::write_new_atomically;
+use qem_mesh::io::{directory_of, write_new_atomically};
 use serde::Serialize;
 use std::collections::BTreeSet;
-use std::path::{Component, Path, PathBuf};
+use std::path::{Component, Path};
 
 /// At most this much of a material library is read for the textures it names (a
 /// library is a few kilobytes of text; a larger file is copied but not searched).
@@ -114,14 +114,6 @@ pub fn copy_beside(input: &Path, output: &Path, libraries: &[Vec<u8>]) -> Materi
         }
     }
     json
-}
-
-/// The directory of `file` (`.` for a bare name).
-fn directory_of(file: &Path) -> PathBuf {
-    match file.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() => dir.to_path_buf(),
-        _ => PathBuf::from("."),
-    }
 }
 
 /// Whether two directory names are one directory.

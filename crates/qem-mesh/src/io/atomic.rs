@@ -127,7 +127,7 @@ fn write_action(kind: ErrorKind) -> &'static str {
 fn create_temp_beside(path: &Path) -> std::io::Result<(PathBuf, File)> {
     use std::sync::atomic::{AtomicU64, Ordering};
     static COUNTER: AtomicU64 = AtomicU64::new(0);
-    let dir = dir_of(path);
+    let dir = directory_of(path);
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
@@ -148,7 +148,13 @@ fn create_temp_beside(path: &Path) -> std::io::Result<(PathBuf, File)> {
 }
 
 /// The directory a file path is in (`.` for a bare name).
-fn dir_of(path: &Path) -> PathBuf {
+///
+/// ```
+/// use std::path::Path;
+/// assert_eq!(qem_mesh::io::directory_of(Path::new("out/a.obj")), Path::new("out"));
+/// assert_eq!(qem_mesh::io::directory_of(Path::new("a.obj")), Path::new("."));
+/// ```
+pub fn directory_of(path: &Path) -> PathBuf {
     match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),

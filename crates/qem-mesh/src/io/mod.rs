@@ -92,8 +92,8 @@ use std::io::{Read, Write};
 use std::path::Path;
 
 pub use atomic::{
-    remove_stale_temporaries, temporary_owner, write_atomically, write_new_atomically,
-    STALE_AGE_WITHOUT_PROC, TEMP_MARKER,
+    directory_of, remove_stale_temporaries, temporary_owner, write_atomically,
+    write_new_atomically, STALE_AGE_WITHOUT_PROC, TEMP_MARKER,
 };
 pub use error::{IoError, Location, ReadError, ReadErrorKind};
 use input::Input;
@@ -375,7 +375,7 @@ pub fn read_path(path: &Path) -> Result<LoadedMesh, IoError> {
     let mut input = std::fs::File::open(path)
         .and_then(Input::file)
         .map_err(file_err)?;
-    let dir = path.parent().unwrap_or(Path::new("."));
+    let dir = directory_of(path);
     let open = |uri: &str, len: usize| read_buffer_file(&dir.join(uri), len);
     let read = read_input(&mut input, format, Some(&open));
     // The system's error reading the file, not a problem of its content.

@@ -113,10 +113,11 @@ pub fn simplify_observed(
 
 /// [`simplify_observed`] for a caller that needs its mesh no more: the mesh is
 /// dropped as soon as it is cleaned, before the setup and the loop (which hold the
-/// most), where a borrowed mesh stays until the caller drops it. (With
-/// [`Method::Clustering`] it is held to the end: each level clusters the input.) That is the
-/// input's positions and triangles less at the peak: about 24 bytes a triangle, 96 MB
-/// on a 4M-triangle mesh. Same output, bit for bit.
+/// most), where a borrowed mesh stays until the caller drops it: the input's positions
+/// and triangles less at the peak, about 24 bytes a triangle (93 MB less on a
+/// 4M-triangle sphere, BENCHMARKS.md "The whole process"). Same output, bit for bit.
+/// (With [`Method::Clustering`] the mesh is held to the end: each level clusters the
+/// input.)
 ///
 /// ```
 /// use qem_mesh::simplify::{simplify_observed, simplify_owned, NoObserver, SimplifyOptions, Target};

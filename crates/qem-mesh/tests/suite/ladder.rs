@@ -4,7 +4,7 @@
 
 use crate::common::{assert_valid, concat, grid, simplify_replayed, topology, uv_sphere};
 use qem_mesh::simplify::{
-    simplify, simplify_levels, BoundaryMode, Constraint, ContractionOrder, NoObserver,
+    simplify, simplify_levels, BoundaryMode, Constraint, ContractionOrder, Length, NoObserver,
     RelaxationStep, SimplifyOptions, StopReason, Target,
 };
 use qem_mesh::IndexedMesh;
@@ -416,5 +416,36 @@ fn each_level_of_a_chain_lands_on_its_small_target() {
         for level in &chain {
             assert!(level.report.relaxations.is_empty(), "{order:?}");
         }
+    }
+}
+
+/// Under an error bound, a pair put off near the target is asked again when the pair
+/// that would land on it is over the bound: on this grid, landing on 41 takes a border
+/// edge dearer than the inner edge that passes to 40, and with the bound between the
+/// two the run passes to 40 instead of stopping at 42 as if the bound had stopped it.
+#[test]
+fn a_put_off_pair_within_the_error_bound_is_taken_when_landing_is_over_it() {
+    let mesh = grid(12, 12, 0.8);
+    for order in ORDERS {
+        let error_to = |target| {
+            simplify(&mesh, &options(order, Target::Triangles(target)))
+                .expect("simplifies")
+                .report
+                .max_error
+        };
+        let (landing, passing) = (error_to(41), error_to(40));
+        assert!(passing < landing, "{order:?}: {passing} against {landing}");
+        let bound = Length::DiagonalFraction((passing + landing) / 2.0);
+        let out = simplify(
+            &mesh,
+            &options(order, Target::Triangles(41)).with_max_error(Some(bound)),
+        )
+        .expect("simplifies");
+        assert_eq!(
+            out.report.stop_reason,
+            StopReason::TargetReached,
+            "{order:?}"
+        );
+        assert_eq!(out.mesh.triangle_count(), 40, "{order:?}");
     }
 }
