@@ -40,6 +40,7 @@ impl WeightedPlane {
     /// The plane of triangle `p0 p1 p2` with weight `area + extra`, as
     /// [`Quadric::from_triangle_area_plus`] weighs it; [`NONE`](Self::NONE) for a
     /// degenerate triangle.
+    #[inline]
     pub fn from_triangle_area_plus(p0: DVec3, p1: DVec3, p2: DVec3, extra: f64) -> Self {
         match unit_normal_and_area(p0, p1, p2) {
             Some((n, area)) => WeightedPlane {
@@ -54,6 +55,7 @@ impl WeightedPlane {
     /// The plane of triangle `p0 p1 p2` with weight 1, as
     /// [`Quadric::from_triangle_unweighted`] weighs it; [`NONE`](Self::NONE) for a
     /// degenerate triangle.
+    #[inline]
     pub fn from_triangle_unweighted(p0: DVec3, p1: DVec3, p2: DVec3) -> Self {
         match unit_normal_and_area(p0, p1, p2) {
             Some((n, _)) => WeightedPlane {

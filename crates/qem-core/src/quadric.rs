@@ -308,6 +308,7 @@ impl Quadric {
 
 /// The unit normal (right-handed, counter-clockwise) and area of a triangle, or
 /// `None` when its cross product cannot be normalised (zero or non-finite area).
+#[inline]
 pub fn unit_normal_and_area(p0: DVec3, p1: DVec3, p2: DVec3) -> Option<(DVec3, f64)> {
     let cross = (p1 - p0).cross(p2 - p0);
     let len = cross.length();

@@ -559,6 +559,7 @@ impl TriangleBvh {
 
     /// The corners of triangle `i` (an index from
     /// [`nearest_triangles`](Self::nearest_triangles)), in their input order.
+    #[inline]
     pub fn corners(&self, i: u32) -> [[f64; 3]; 3] {
         self.corners.get(i as usize)
     }

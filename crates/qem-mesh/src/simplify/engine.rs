@@ -21,6 +21,7 @@
 use super::checks::{Facing, Rejection};
 use super::counters::Counters;
 use super::incidence::Incidence;
+use super::input_faces::{weighted_plane, InputFaces};
 use super::locality::{in_locality_order, in_original_order, Renumbered};
 use super::nth_key::nth_key;
 use super::observer::{Contraction, Observer, Progress};
@@ -114,8 +115,9 @@ pub(super) struct Engine {
     triangles: Vec<[u32; 3]>,
     /// The indices of the live triangles, in increasing order.
     live: Vec<u32>,
-    /// Which way each input triangle faces (in the normalised frame).
-    original_normals: Vec<Facing>,
+    /// Which way each input triangle faces (in the normalised frame), and its face
+    /// plane.
+    input_faces: InputFaces,
     /// The pass in which each vertex last moved or was removed.
     moved_in: Vec<u32>,
     pass: u32,
@@ -133,14 +135,15 @@ pub(super) struct Engine {
     selected: Vec<u32>,
     /// Where each vertex's edges (as the smaller end) start in `candidates`, as listed.
     listed_first: Vec<u32>,
-    /// The last pass's edges and costs in listing order, and where each vertex's start.
+    /// The last pass's edges whose costs this pass may reuse, with their costs, in
+    /// listing order, and where each vertex's start ([`Engine::keep_reusable_costs`]).
     last_listed: Vec<Candidate>,
     last_listed_first: Vec<u32>,
     /// Whether the costs of `last_listed` were computed with merges allowed (which
     /// price a part that vanishes: [`Engine::vanishing_radius`]).
     last_costed_with_merges: bool,
     /// The candidates whose cost this pass ranks at the waivers' penalty, with their
-    /// costs before it (restored before the list becomes `last_listed`).
+    /// costs before it (restored before the reusable ones are kept).
     unpenalised_costs: Vec<(u32, f64)>,
     /// Per vertex, the last vertex whose edges were listed with it (edge listing).
     seen_with: Vec<u32>,
@@ -191,7 +194,7 @@ macro_rules! fixed_of {
             frame: &$engine.frame,
             settings: &$engine.settings,
             incidence: &$engine.incidence,
-            original_normals: &$engine.original_normals,
+            input_faces: &$engine.input_faces,
             vertex_from: &$engine.vertex_from,
             pass: $engine.pass,
             exact: $engine.exact.as_ref(),
@@ -229,6 +232,32 @@ impl Engine {
         locked: &[u32],
         options: &SimplifyOptions,
     ) -> Self {
+        // The orientation check's index is independent of the rest of the setup: built
+        // on the other core meanwhile (deterministic either way).
+        let ((mut engine, area_offset), surface) = rayon::join(
+            || Engine::set_up(cleaned, frame, locked, options),
+            || {
+                options
+                    .orientation_check
+                    .then(|| InputSurface::new(cleaned, &frame))
+            },
+        );
+        match surface {
+            Some((surface, slots)) => engine.set_input_surface(surface, &slots, area_offset),
+            None => engine.input_faces = engine.kept_input_faces(area_offset),
+        }
+        engine
+    }
+
+    /// [`new`](Self::new) but for the orientation check's index and the input faces
+    /// (left empty); also returns the constant the face planes' weighting adds to
+    /// face areas.
+    fn set_up(
+        cleaned: &IndexedMesh,
+        frame: Frame,
+        locked: &[u32],
+        options: &SimplifyOptions,
+    ) -> (Self, Option<f64>) {
         let Renumbered {
             mesh,
             vertex_from,
@@ -236,6 +265,7 @@ impl Engine {
             triangle_from,
         } = in_locality_order(cleaned, &frame);
         let n = mesh.positions.len();
+        let mesh_triangle_count = mesh.triangles.len();
         let position: Vec<DVec3> = mesh
             .positions
             .par_iter()
@@ -264,7 +294,9 @@ impl Engine {
             locked: vec![false; n],
             triangles: mesh.triangles,
             live,
-            original_normals: Vec::new(),
+            // Set by `new`, once it knows whether the orientation check's index holds
+            // the input.
+            input_faces: InputFaces::kept(Vec::new(), Vec::new(), None),
             moved_in: vec![0; n],
             pass: 0,
             incidence: Incidence::default(),
@@ -290,7 +322,8 @@ impl Engine {
             since_report: 0,
             input_surface: None,
             waivers: Waivers::new(n),
-            exact: (options.quadrics == QuadricMode::Exact).then(|| PassExact::new(n)),
+            exact: (options.quadrics == QuadricMode::Exact)
+                .then(|| PassExact::new(n, mesh_triangle_count)),
             position,
             block_vertices: BLOCK_VERTICES,
             block_triangles: Vec::new(),
@@ -321,16 +354,29 @@ impl Engine {
         engine.find_virtual_pairs(options);
         engine.counters.locked_vertices = engine.locked.iter().filter(|&&l| l).count();
         engine.settings.any_locked = engine.counters.locked_vertices > 0;
-        engine
+        (engine, area_offset)
     }
 
     /// Turns the orientation check on with `surface`, built from the same cleaned mesh
     /// (`slots` as [`InputSurface::new`] returned them): each triangle's first hint is
-    /// its own input triangle.
-    pub fn set_input_surface(&mut self, mut surface: InputSurface, slots: &[u32]) {
+    /// its own input triangle. The input faces are read from its index (kept, when it
+    /// does not hold every triangle), their planes weighted with `area_offset`.
+    fn set_input_surface(
+        &mut self,
+        mut surface: InputSurface,
+        slots: &[u32],
+        area_offset: Option<f64>,
+    ) {
         let hints = (self.triangle_from.iter().enumerate())
             .map(|(t, &cleaned_t)| (t, slots[cleaned_t as usize]));
         surface.seed_hints(hints);
+        let slot = (self.triangle_from.iter())
+            .map(|&cleaned_t| slots[cleaned_t as usize])
+            .collect();
+        self.input_faces = match InputFaces::from_index(surface.index(), slot, area_offset) {
+            Some(faces) => faces,
+            None => self.kept_input_faces(area_offset),
+        };
         self.input_surface = Some(surface);
     }
 
@@ -418,10 +464,10 @@ impl Engine {
         t.map(|c| self.position[c as usize])
     }
 
-    /// Each face's normal and plane, and each vertex's quadric summed along its incident
-    /// list (both on the thread pool; each sum in a fixed order, so the bits do not
-    /// depend on the thread count). Needs the incident lists. Returns the weighting's
-    /// constant added to face areas (`None`: unit weights).
+    /// Each vertex's quadric, summed from the weighted planes of the triangles along
+    /// its incident list (on the thread pool; each sum in a fixed order, so the bits do
+    /// not depend on the thread count). Needs the incident lists. Returns the
+    /// weighting's constant added to face areas (`None`: unit weights).
     fn sum_face_planes(&mut self, options: &SimplifyOptions) -> Option<f64> {
         // The areas on both cores, summed on one in the order of `live`: the bits of
         // that order, whatever the thread count.
@@ -440,13 +486,37 @@ impl Engine {
             areas / self.live.len() as f64
         };
         let area_offset = options.weighting.area_offset(mean_area);
-        // Each triangle's normal and weighted plane, by triangle index, on both cores;
-        // a triangle that is not live keeps a zero normal (never read) and no plane.
-        // Planes rather than quadrics kept (40 bytes a triangle instead of 80, at the
-        // setup's memory peak); with exact quadrics the planes are kept for the run.
-        // Both arrays are written once, by the threads that compute them: filled
-        // arrays made first were 64 bytes a triangle of pages faulted in and zeroed on
-        // one core (14% of the sphere:4M run's page faults), then written again.
+        // Each vertex's quadric, summed over its live triangles in the order of
+        // `live` (the order of its incident list): the bits the sum in that order gives,
+        // whatever the thread count. Each plane is computed at each of its three
+        // corners rather than once into an array: the array was 40 bytes a triangle at
+        // the setup's memory peak, and with the orientation check on nothing keeps it
+        // afterwards (`InputFaces` reads the planes from the check's index).
+        let (position, triangles, incidence) = (&self.position, &self.triangles, &self.incidence);
+        self.quadric = (0..self.position.len() as u32)
+            .into_par_iter()
+            .map(|v| {
+                let mut sum = Quadric::default();
+                for &t in incidence.of(v) {
+                    let [pa, pb, pc] = triangles[t as usize].map(|c| position[c as usize]);
+                    sum += weighted_plane(pa, pb, pc, area_offset).quadric();
+                }
+                sum
+            })
+            .collect();
+        area_offset
+    }
+
+    /// Each input triangle's facing and, with exact quadrics, weighted face plane
+    /// (with `area_offset`, as [`sum_face_planes`](Self::sum_face_planes) weighted
+    /// them), kept: the input faces without the orientation check's index. Only
+    /// before the run: it reads the triangles' current corners.
+    fn kept_input_faces(&self, area_offset: Option<f64>) -> InputFaces {
+        // By triangle index, on both cores; a triangle that is not live keeps a zero
+        // normal and no plane (neither is ever read). Both arrays are written once, by
+        // the threads that compute them: filled arrays made first were pages faulted
+        // in and zeroed on one core (14% of the sphere:4M run's page faults), then
+        // written again.
         let count = self.triangles.len();
         let is_live = (self.live.len() < count).then(|| {
             let mut is_live = vec![false; count];
@@ -456,7 +526,8 @@ impl Engine {
             is_live
         });
         let (position, triangles) = (&self.position, &self.triangles);
-        let (mut normals, mut planes) = (Vec::new(), Vec::new());
+        let with_planes = self.exact.is_some();
+        let (mut facing, mut planes) = (Vec::new(), Vec::new());
         (0..count)
             .into_par_iter()
             .map(|t| {
@@ -464,33 +535,18 @@ impl Engine {
                     return (Facing::default(), WeightedPlane::NONE);
                 }
                 let [pa, pb, pc] = triangles[t].map(|c| position[c as usize]);
-                let plane = match area_offset {
-                    Some(extra) => WeightedPlane::from_triangle_area_plus(pa, pb, pc, extra),
-                    None => WeightedPlane::from_triangle_unweighted(pa, pb, pc),
+                let plane = if with_planes {
+                    weighted_plane(pa, pb, pc, area_offset)
+                } else {
+                    WeightedPlane::NONE
                 };
                 (Facing::of((pb - pa).cross(pc - pa)), plane)
             })
-            .unzip_into_vecs(&mut normals, &mut planes);
-        // Each vertex's quadric, summed over its live triangles in the order of
-        // `live` (the order of its incident list): the bits the sum in that order gives,
-        // whatever the thread count. (Made from the plane at each corner rather than
-        // kept per triangle: 80 bytes a triangle saved.)
-        let incidence = &self.incidence;
-        self.quadric = (0..self.position.len() as u32)
-            .into_par_iter()
-            .map(|v| {
-                let mut sum = Quadric::default();
-                for &t in incidence.of(v) {
-                    sum += planes[t as usize].quadric();
-                }
-                sum
-            })
-            .collect();
-        self.original_normals = normals;
-        if let Some(exact) = &mut self.exact {
-            exact.set_face_planes(planes);
+            .unzip_into_vecs(&mut facing, &mut planes);
+        if !with_planes {
+            planes = Vec::new();
         }
-        area_offset
+        InputFaces::kept(facing, planes, area_offset)
     }
 }
 
@@ -625,8 +681,8 @@ impl Engine {
     }
 
     /// Lists every edge of the live triangles once, as (smaller end, larger end), in
-    /// order of the smaller end. The last pass's list, with its costs as computed
-    /// (unpenalised), becomes `last_listed`, and the list before it is overwritten.
+    /// order of the smaller end. Of the last pass's list, with its costs as computed
+    /// (unpenalised), what this pass may reuse becomes `last_listed`.
     fn list_edges(&mut self) {
         // Handed over rather than copied at costing time: the copy was 16 bytes an edge
         // a pass, the first pass's onto fresh pages.
@@ -635,6 +691,7 @@ impl Engine {
         }
         std::mem::swap(&mut self.candidates, &mut self.last_listed);
         std::mem::swap(&mut self.listed_first, &mut self.last_listed_first);
+        self.keep_reusable_costs();
         self.seen_with.fill(u32::MAX);
         self.candidates.clear();
         self.listed_first.clear();
@@ -710,6 +767,51 @@ impl Engine {
         }
     }
 
+    /// Keeps, of the last pass's list (`last_listed`), only the edges whose cost this
+    /// pass may reuse ([`last_cost`](Self::last_cost): neither end moved in that pass,
+    /// and it was costed without merges), and gives the memory of the rest back.
+    ///
+    /// Why: the last pass's list beside this one's, 16 bytes an edge each, was the
+    /// largest item of the loop's memory peak (48 bytes an input triangle with this
+    /// pass's, BENCHMARKS.md "The budget, array by array"), and the early passes,
+    /// whose lists are the longest, move most vertices, so most of it was never read.
+    /// (Kept whole, the lists' two buffers also each held the longest list they had
+    /// ever held.)
+    fn keep_reusable_costs(&mut self) {
+        let last = self.pass.checked_sub(1).filter(|&p| p > 0);
+        // (A list the greedy order took has nothing left to keep.)
+        let whole =
+            self.last_listed_first.last().map(|&end| end as usize) == Some(self.last_listed.len());
+        let (list, first, moved_in) = (
+            &mut self.last_listed,
+            &mut self.last_listed_first,
+            &self.moved_in,
+        );
+        match last {
+            Some(last) if whole && !self.last_costed_with_merges => {
+                let mut kept = 0;
+                for v in 0..first.len() - 1 {
+                    let range = first[v] as usize..first[v + 1] as usize;
+                    first[v] = kept as u32;
+                    for i in range {
+                        let c = list[i];
+                        if moved_in[c.a as usize] != last && moved_in[c.b as usize] != last {
+                            list[kept] = c;
+                            kept += 1;
+                        }
+                    }
+                }
+                *first.last_mut().expect("a whole list has an end") = kept as u32;
+                list.truncate(kept);
+            }
+            _ => {
+                list.clear();
+                first.clear();
+            }
+        }
+        list.shrink_to_fit();
+    }
+
     /// The cost of the edge `a b` (`a < b`) in the last pass's list, when neither end
     /// moved in that pass. Never with merges allowed, nor when the last pass allowed
     /// them: whether a pair makes a part vanish depends on its neighbours' triangles too, and
@@ -722,9 +824,9 @@ impl Engine {
         if self.moved_in[a as usize] == last || self.moved_in[b as usize] == last {
             return None;
         }
-        let range = self.last_listed_first[a as usize] as usize
-            ..self.last_listed_first[a as usize + 1] as usize;
-        self.last_listed[range]
+        let start = *self.last_listed_first.get(a as usize)? as usize;
+        let end = *self.last_listed_first.get(a as usize + 1)? as usize;
+        self.last_listed[start..end]
             .iter()
             .find(|c| c.b == b)
             .map(|c| c.cost)
@@ -869,7 +971,7 @@ impl Engine {
     /// `Q_ab` of exact quadrics for `a` and `b` ([`shared_planes`]).
     fn shared_planes(&self, exact: &PassExact, a: u32, b: u32) -> Quadric {
         let triangles = (0, &self.triangles[..]);
-        shared_planes(&self.incidence, triangles, exact, [a, b])
+        shared_planes(&self.incidence, triangles, exact, &self.input_faces, [a, b])
     }
 
     /// Takes the removed triangles off the live list, ending the pass.
@@ -932,7 +1034,7 @@ impl Engine {
                 let [p0, p1, p2] = self.corners(self.triangles[t as usize]);
                 (p1 - p0)
                     .cross(p2 - p0)
-                    .dot(self.original_normals[t as usize].normal())
+                    .dot(self.input_faces.facing(t).normal())
                     < 0.0
             })
             .count()

@@ -203,14 +203,14 @@ impl Engine {
             if corners[0] == REMOVED {
                 continue;
             }
-            let plane = exact.face_quadric(t);
+            let plane = self.input_faces.quadric(t);
             for c in corners {
                 if c != v {
                     add(c, plane);
                 }
             }
         }
-        for (n, plane) in exact.segments_at(v) {
+        for (n, plane) in exact.segments_at(&self.input_faces, v) {
             add(n, plane);
         }
     }

@@ -37,6 +37,7 @@ mod checks;
 mod counters;
 mod engine;
 mod incidence;
+mod input_faces;
 mod ladder;
 mod locality;
 mod nth_key;
@@ -242,19 +243,7 @@ fn levels_of(
 
     let frame = Frame::from_points(cleaned.mesh.positions.iter().map(|p| DVec3::from_array(*p)));
     let clock = Instant::now();
-    // The orientation check's index is independent of the rest of the setup: built on
-    // the other core meanwhile (deterministic either way).
-    let (mut engine, input_surface) = rayon::join(
-        || Engine::new(&cleaned.mesh, frame, &locked, options),
-        || {
-            options
-                .orientation_check
-                .then(|| orientation::InputSurface::new(&cleaned.mesh, &frame))
-        },
-    );
-    if let Some((surface, slots)) = input_surface {
-        engine.set_input_surface(surface, &slots);
-    }
+    let mut engine = Engine::new(&cleaned.mesh, frame, &locked, options);
     timings.setup = clock.elapsed();
     observer.cleaned(&cleaned.mesh, &frame);
     // The loop needs the cleaned mesh no more: gone before it starts (about 120 MB on

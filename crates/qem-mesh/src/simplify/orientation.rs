@@ -19,6 +19,7 @@
 use crate::measure::TriangleBvh;
 use crate::IndexedMesh;
 use qem_core::{DVec3, Frame};
+use std::sync::Arc;
 
 /// Input triangles up to this factor farther than the nearest one count as "nearest".
 /// Why not 1: a centroid over a shared edge or vertex is equally near to several
@@ -64,7 +65,9 @@ fn centroid_and_normal(corners: [DVec3; 3]) -> (DVec3, DVec3) {
 /// The input surface, indexed for nearest-triangle queries, in normalised units.
 #[derive(Debug)]
 pub(super) struct InputSurface {
-    bvh: TriangleBvh,
+    /// Shared with [`super::input_faces::InputFaces`], which reads the input
+    /// triangles' facings and planes from it.
+    bvh: Arc<TriangleBvh>,
     /// Reused query result.
     near: Vec<u32>,
     /// Per face, an input triangle near it: at first the face's own input triangle,
@@ -92,7 +95,7 @@ impl InputSurface {
             frame.to_normalized(DVec3::from_array(p)).to_array()
         });
         let surface = InputSurface {
-            bvh,
+            bvh: Arc::new(bvh),
             near: Vec::new(),
             hints: Vec::new(),
         };
@@ -174,6 +177,11 @@ impl InputSurface {
     /// share of the hints).
     pub fn parts(&mut self) -> (Nearest<'_>, &mut [u32]) {
         (Nearest { bvh: &self.bvh }, &mut self.hints)
+    }
+
+    /// The index of the input triangles, to share.
+    pub fn index(&self) -> Arc<TriangleBvh> {
+        Arc::clone(&self.bvh)
     }
 
     /// Makes `t` the hint of `face`.

@@ -33,9 +33,10 @@
 //! the first round of passes 1-3 were interior (counted in a scratch build). (BENCHMARKS.md,
 //! "Rounds block by block".)
 
-use super::checks::{moved_face_verdict, Facing, Rejection};
+use super::checks::{moved_face_verdict, Rejection};
 use super::counters::Counters;
 use super::incidence::Incidence;
+use super::input_faces::InputFaces;
 use super::observer::Contraction;
 use super::orientation::Nearest;
 use super::pass_exact::PassExact;
@@ -74,8 +75,8 @@ pub(super) struct Fixed<'a> {
     pub settings: &'a Settings,
     /// The live triangles around each vertex at the pass's start.
     pub incidence: &'a Incidence,
-    /// Which way each input triangle faces (normalised frame).
-    pub original_normals: &'a [Facing],
+    /// Which way each input triangle faces (normalised frame), and its face plane.
+    pub input_faces: &'a InputFaces,
     /// Each engine vertex's number in the cleaned mesh (for the observer).
     pub vertex_from: &'a [u32],
     pub pass: u32,
@@ -144,7 +145,7 @@ impl Corners<'_> {
                 fixed.settings,
                 old,
                 new,
-                || fixed.original_normals[x.triangle as usize].normal(),
+                || fixed.input_faces.facing(x.triangle).normal(),
                 || {
                     cross_underflows(corners.map(|c| {
                         if c == a || c == b {
@@ -455,7 +456,7 @@ pub(super) fn contract_block(
         let mut q = slab.quadric[sa] + slab.quadric[sb];
         if let Some(exact) = fixed.exact {
             let triangles = (slab.first_triangle, &*slab.triangles);
-            q -= shared_planes(fixed.incidence, triangles, exact, [a, b]);
+            q -= shared_planes(fixed.incidence, triangles, exact, fixed.input_faces, [a, b]);
         }
         let ends = [(slab.position[sa], false), (slab.position[sb], false)];
         let placed = place_merged(&q, ends, fixed.settings.placement);
@@ -761,7 +762,7 @@ fn keeps_border_loops(a: u32, b: u32, shared: usize, around: &[Vec<Around>; 2]) 
 
 /// `Q_ab` of exact quadrics (see [`super::pass_exact`]) for `a` and `b`, both unmoved in
 /// this pass: the face planes of the live triangles on both, then the segments joining
-/// them. `incidence` lists the triangles around each vertex;
+/// them (face planes from `faces`). `incidence` lists the triangles around each vertex;
 /// `triangles` holds the triangles from the number it is paired with on, which must
 /// include every triangle around `a` and `b`.
 ///
@@ -774,6 +775,7 @@ pub(super) fn shared_planes(
     incidence: &Incidence,
     (first_triangle, triangles): (u32, &[[u32; 3]]),
     exact: &PassExact,
+    faces: &InputFaces,
     [a, b]: [u32; 2],
 ) -> Quadric {
     let (walked, other) = incidence.shorter(a, b);
@@ -781,8 +783,8 @@ pub(super) fn shared_planes(
     for &t in incidence.of(walked) {
         let corners = triangles[(t - first_triangle) as usize];
         if corners[0] != REMOVED && corners.contains(&other) {
-            sum += exact.face_quadric(t);
+            sum += faces.quadric(t);
         }
     }
-    sum + exact.segments_between(a, b)
+    sum + exact.segments_between(faces, a, b)
 }

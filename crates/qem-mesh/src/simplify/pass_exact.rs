@@ -29,15 +29,16 @@
 //! list is walked.
 
 use super::incidence::Incidence;
-use qem_core::{Quadric, WeightedPlane};
+use super::input_faces::InputFaces;
+use qem_core::Quadric;
 
 /// A plane supported by exactly two current vertices.
 #[derive(Clone, Copy, Debug)]
 struct Segment {
     /// Its two current ends (kept current by [`PassExact::contract`]).
     ends: [u32; 2],
-    /// Its plane: a triangle index (the triangle's face plane), or the triangle count
-    /// plus an index into [`PassExact::border_planes`].
+    /// Its plane: a triangle index (the triangle's face plane, from [`InputFaces`]),
+    /// or the triangle count plus an index into [`PassExact::border_planes`].
     source: u32,
 }
 
@@ -47,8 +48,9 @@ const GONE: [u32; 2] = [u32::MAX, u32::MAX];
 /// The bookkeeping of exact quadrics in a run (either order).
 #[derive(Debug)]
 pub(super) struct PassExact {
-    /// Each input triangle's weighted face plane (the one summed into its corners).
-    face_planes: Vec<WeightedPlane>,
+    /// How many input triangles there are (their face planes are [`InputFaces`]'):
+    /// the first border plane's source number.
+    triangle_count: usize,
     /// The border planes' quadrics, in the order they were added.
     border_planes: Vec<Quadric>,
     segments: Vec<Segment>,
@@ -59,11 +61,11 @@ pub(super) struct PassExact {
 }
 
 impl PassExact {
-    /// No plane yet, for `vertex_count` vertices (the face planes come with
-    /// [`set_face_planes`](Self::set_face_planes)).
-    pub fn new(vertex_count: usize) -> Self {
+    /// No segment yet, for `vertex_count` vertices and `triangle_count` input
+    /// triangles.
+    pub fn new(vertex_count: usize, triangle_count: usize) -> Self {
         let mut exact = PassExact {
-            face_planes: Vec::new(),
+            triangle_count,
             border_planes: Vec::new(),
             segments: Vec::new(),
             by_end: Incidence::default(),
@@ -73,22 +75,9 @@ impl PassExact {
         exact
     }
 
-    /// Records every triangle's face plane, by triangle index; before any border plane
-    /// is added (a border plane's source number counts the triangles).
-    pub fn set_face_planes(&mut self, planes: Vec<WeightedPlane>) {
-        debug_assert!(self.border_planes.is_empty());
-        self.face_planes = planes;
-    }
-
-    /// The quadric of triangle `t`'s face plane.
-    #[inline]
-    pub fn face_quadric(&self, t: u32) -> Quadric {
-        self.face_planes[t as usize].quadric()
-    }
-
     /// Records a border plane `q` on the edge `a b`.
     pub fn add_border_plane(&mut self, a: u32, b: u32, q: Quadric) {
-        let source = (self.face_planes.len() + self.border_planes.len()) as u32;
+        let source = (self.triangle_count + self.border_planes.len()) as u32;
         self.border_planes.push(q);
         self.add_segment([a, b], source);
     }
@@ -135,42 +124,45 @@ impl PassExact {
         });
     }
 
-    /// The sum of the segments joining `a` and `b`.
+    /// The sum of the segments joining `a` and `b` (face planes from `faces`).
     ///
     /// Walks the shorter of the two ends' lists (a vertex that absorbed many others
     /// has a long one). After [`start_pass`](Self::start_pass) both list the segments
     /// in increasing order, so the sum is the same to the bit either way.
     #[inline]
-    pub fn segments_between(&self, a: u32, b: u32) -> Quadric {
+    pub fn segments_between(&self, faces: &InputFaces, a: u32, b: u32) -> Quadric {
         let (walked, other) = self.by_end.shorter(a, b);
         let mut sum = Quadric::ZERO;
         for &i in self.by_end.of(walked) {
             let s = self.segments[i as usize];
             if s.ends.contains(&other) {
-                sum += self.plane(s.source);
+                sum += self.plane(faces, s.source);
             }
         }
         sum
     }
 
     /// Each segment at `v` that joins it to another vertex: that vertex and the
-    /// segment's plane.
-    pub fn segments_at(&self, v: u32) -> impl Iterator<Item = (u32, Quadric)> + '_ {
+    /// segment's plane (face planes from `faces`).
+    pub fn segments_at<'a>(
+        &'a self,
+        faces: &'a InputFaces,
+        v: u32,
+    ) -> impl Iterator<Item = (u32, Quadric)> + 'a {
         self.by_end.of(v).iter().filter_map(move |&i| {
             let s = self.segments[i as usize];
             (s.ends != GONE).then(|| {
                 let other = if s.ends[0] == v { s.ends[1] } else { s.ends[0] };
-                (other, self.plane(s.source))
+                (other, self.plane(faces, s.source))
             })
         })
     }
 
     /// The quadric of a segment's plane.
-    fn plane(&self, source: u32) -> Quadric {
-        let triangles = self.face_planes.len();
-        match (source as usize).checked_sub(triangles) {
+    fn plane(&self, faces: &InputFaces, source: u32) -> Quadric {
+        match (source as usize).checked_sub(self.triangle_count) {
             Some(border) => self.border_planes[border],
-            None => self.face_quadric(source),
+            None => faces.quadric(source),
         }
     }
 }
@@ -178,7 +170,8 @@ impl PassExact {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use qem_core::DVec3;
+    use crate::simplify::checks::Facing;
+    use qem_core::{DVec3, WeightedPlane};
 
     fn plane(z: f64) -> WeightedPlane {
         WeightedPlane::from_triangle_unweighted(
@@ -192,8 +185,13 @@ mod tests {
     /// become one vertex is forgotten.
     #[test]
     fn segments_follow_merges_and_vanish_when_their_ends_meet() {
-        let mut e = PassExact::new(6);
-        e.set_face_planes(vec![plane(1.0), plane(2.0)]);
+        let mut e = PassExact::new(6, 2);
+        let faces = InputFaces::kept(
+            vec![Facing::default(); 2],
+            vec![plane(1.0), plane(2.0)],
+            None,
+        );
+        let face = |t| faces.quadric(t);
         let border = Quadric::from_plane(DVec3::X, -3.0);
         e.add_border_plane(4, 5, border);
         // Triangle 0 on 0 1 2 collapses as 1 goes into 0: a segment 0–2.
@@ -201,18 +199,18 @@ mod tests {
         // Triangle 1 on 2 3 4 collapses as 3 goes into 2: a segment 2–4.
         e.contract(2, 3, [(1, 4)].into_iter());
         e.start_pass();
-        assert_eq!(e.segments_between(0, 2), e.face_quadric(0));
-        assert_eq!(e.segments_between(2, 0), e.face_quadric(0));
-        assert_eq!(e.segments_between(2, 4), e.face_quadric(1));
-        assert_eq!(e.segments_between(4, 5), border);
-        assert_eq!(e.segments_between(0, 4), Quadric::ZERO);
+        assert_eq!(e.segments_between(&faces, 0, 2), face(0));
+        assert_eq!(e.segments_between(&faces, 2, 0), face(0));
+        assert_eq!(e.segments_between(&faces, 2, 4), face(1));
+        assert_eq!(e.segments_between(&faces, 4, 5), border);
+        assert_eq!(e.segments_between(&faces, 0, 4), Quadric::ZERO);
         // 5 into 4, then 4 into 2: the border plane now joins nothing (one vertex),
         // the segment 2–4 neither; 0–2 stays.
         e.contract(4, 5, std::iter::empty());
         e.contract(2, 4, std::iter::empty());
         e.start_pass();
         assert_eq!(e.segments.len(), 1);
-        assert_eq!(e.segments_between(0, 2), e.face_quadric(0));
+        assert_eq!(e.segments_between(&faces, 0, 2), face(0));
         // Then 2 into 0: nothing left.
         e.contract(0, 2, std::iter::empty());
         e.start_pass();

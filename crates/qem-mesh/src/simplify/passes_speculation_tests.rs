@@ -105,10 +105,6 @@ pub(super) fn run_levels(
         let frame =
             Frame::from_points(cleaned.mesh.positions.iter().map(|p| DVec3::from_array(*p)));
         let mut engine = Engine::new(&cleaned.mesh, frame, &locked, options);
-        if options.orientation_check {
-            let (surface, slots) = InputSurface::new(&cleaned.mesh, &frame);
-            engine.set_input_surface(surface, &slots);
-        }
         engine.probes.speculate_chunks = setup.speculation;
         if let Some(block_vertices) = setup.block_vertices {
             engine.set_block_vertices(block_vertices);
