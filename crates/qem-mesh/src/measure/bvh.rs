@@ -124,6 +124,54 @@ impl Box32 {
     }
 }
 
+/// A box of unit normals in steps of 1/127 ([`NORMAL_STEPS`]), rounded outward from
+/// [`Box32`] bounds: `lo > hi` when empty.
+///
+/// Why so coarse: the facing-away search only asks whether all the normals under a
+/// child face a query's way with a margin ([`super::facing`]); a box a step wider
+/// opens a node a little sooner, never skips one an exact box would open, so no answer
+/// changes. A wide node's normal boxes take 24 bytes instead of 96 (its size 144 bytes
+/// instead of 216; the orientation check's index holds one node for about six input
+/// triangles for the whole run: 12.6 bytes a triangle, BENCHMARKS.md "The budget,
+/// array by array").
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct NormalBox {
+    pub lo: [i8; 3],
+    pub hi: [i8; 3],
+}
+
+/// The steps of [`NormalBox`] per unit.
+pub(super) const NORMAL_STEPS: f32 = 127.0;
+
+impl NormalBox {
+    /// Holds nothing; growing it by a box gives that box.
+    pub const EMPTY: NormalBox = NormalBox {
+        lo: [i8::MAX; 3],
+        hi: [i8::MIN; 3],
+    };
+
+    /// The least box of steps holding `bounds` (unit normals' bounds, so within a
+    /// rounding of ±1; a bound beyond ±128/127 is clamped, which the facing test's
+    /// margin covers for bounds that close to ±1). The product by 127 is exact in
+    /// `f64` (24 + 7 bits), so the floor and ceiling round outward exactly.
+    pub fn around(bounds: &Box32) -> NormalBox {
+        let step = |x: f32, round: fn(f64) -> f64| {
+            round(f64::from(x) * f64::from(NORMAL_STEPS)).clamp(-128.0, 127.0) as i8
+        };
+        NormalBox {
+            lo: bounds.lo.map(|x| step(x, f64::floor)),
+            hi: bounds.hi.map(|x| step(x, f64::ceil)),
+        }
+    }
+
+    fn grow(&mut self, other: &NormalBox) {
+        for k in 0..3 {
+            self.lo[k] = self.lo[k].min(other.lo[k]);
+            self.hi[k] = self.hi[k].max(other.hi[k]);
+        }
+    }
+}
+
 /// A node of the stored tree: its (up to) four children's boxes, by axis then child,
 /// so that each test reads four adjacent lanes.
 #[derive(Clone, Debug)]
@@ -131,10 +179,11 @@ pub(super) struct WideNode {
     /// Position boxes: `lo[k][i]` is the least `k` coordinate under child `i`.
     pub lo: [[f32; WIDTH]; 3],
     pub hi: [[f32; WIDTH]; 3],
-    /// Boxes of the unit normals under each child, for the orientation check's
-    /// facing-away search (empty when all its triangles have zero area).
-    pub normal_lo: [[f32; WIDTH]; 3],
-    pub normal_hi: [[f32; WIDTH]; 3],
+    /// Boxes of the unit normals under each child ([`NormalBox`]'s steps), for the
+    /// orientation check's facing-away search (empty when all its triangles have zero
+    /// area).
+    pub normal_lo: [[i8; WIDTH]; 3],
+    pub normal_hi: [[i8; WIDTH]; 3],
     /// An inner child: its node's index. A leaf child: its first leaf entry.
     pub child: [u32; WIDTH],
     /// A leaf child: how many entries (1..=LEAF_SIZE); an inner child: 0.
@@ -148,14 +197,14 @@ impl WideNode {
     const EMPTY: WideNode = WideNode {
         lo: [[f32::INFINITY; WIDTH]; 3],
         hi: [[f32::NEG_INFINITY; WIDTH]; 3],
-        normal_lo: [[f32::INFINITY; WIDTH]; 3],
-        normal_hi: [[f32::NEG_INFINITY; WIDTH]; 3],
+        normal_lo: [[i8::MAX; WIDTH]; 3],
+        normal_hi: [[i8::MIN; WIDTH]; 3],
         child: [u32::MAX; WIDTH],
         leaf_count: [0; WIDTH],
         lanes: 0,
     };
 
-    pub(super) fn set_child(&mut self, i: usize, position: &Box32, normals: &Box32) {
+    pub(super) fn set_child(&mut self, i: usize, position: &Box32, normals: &NormalBox) {
         for k in 0..3 {
             self.lo[k][i] = position.lo[k];
             self.hi[k][i] = position.hi[k];
@@ -929,7 +978,11 @@ fn fill_boxes(nodes: &mut [WideNode], entry: impl Fn(usize) -> ([P3; 3], (P3, P3
                     normals.grow(&Box32::around([-1.0; 3], [1.0; 3]));
                 }
             }
-            node.set_child(i, &Box32::around(bounds.lo, bounds.hi), &normals);
+            node.set_child(
+                i,
+                &Box32::around(bounds.lo, bounds.hi),
+                &NormalBox::around(&normals),
+            );
         }
     });
     for w in (0..nodes.len()).rev() {
@@ -938,15 +991,17 @@ fn fill_boxes(nodes: &mut [WideNode], entry: impl Fn(usize) -> ([P3; 3], (P3, P3
                 continue;
             }
             let mut position = Box32::EMPTY;
-            let mut normals = Box32::EMPTY;
+            let mut normals = NormalBox::EMPTY;
             let child = &nodes[nodes[w].child[i] as usize];
             for j in 0..usize::from(child.lanes) {
-                let lane = |lo: &[[f32; WIDTH]; 3], hi: &[[f32; WIDTH]; 3]| Box32 {
-                    lo: [0, 1, 2].map(|k| lo[k][j]),
-                    hi: [0, 1, 2].map(|k| hi[k][j]),
-                };
-                position.grow(&lane(&child.lo, &child.hi));
-                normals.grow(&lane(&child.normal_lo, &child.normal_hi));
+                position.grow(&Box32 {
+                    lo: [0, 1, 2].map(|k| child.lo[k][j]),
+                    hi: [0, 1, 2].map(|k| child.hi[k][j]),
+                });
+                normals.grow(&NormalBox {
+                    lo: [0, 1, 2].map(|k| child.normal_lo[k][j]),
+                    hi: [0, 1, 2].map(|k| child.normal_hi[k][j]),
+                });
             }
             nodes[w].set_child(i, &position, &normals);
         }
@@ -956,6 +1011,43 @@ fn fill_boxes(nodes: &mut [WideNode], entry: impl Fn(usize) -> ([P3; 3], (P3, P3
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A box of normals in steps holds the bounds it was made from, is at most a step
+    /// wider on each side, and stays empty when empty.
+    #[test]
+    fn normal_boxes_in_steps_round_outward() {
+        for x in [
+            -1.0f32,
+            -0.5,
+            -1e-9,
+            0.0,
+            1e-9,
+            0.3,
+            0.999_999,
+            1.0,
+            1.000_000_1,
+        ] {
+            let b = NormalBox::around(&Box32 {
+                lo: [x; 3],
+                hi: [x; 3],
+            });
+            let (lo, hi) = (
+                f32::from(b.lo[0]) / NORMAL_STEPS,
+                f32::from(b.hi[0]) / NORMAL_STEPS,
+            );
+            // (Beyond 1, clamped: within the facing test's margin of the bound.)
+            assert!(lo <= x && (hi >= x || x > 1.0), "{x}: {lo} {hi}");
+            assert!(
+                x - lo <= 1.0 / NORMAL_STEPS && hi - x <= 1.0 / NORMAL_STEPS,
+                "{x}"
+            );
+        }
+        let half = NormalBox::around(&Box32::around([0.5; 3], [0.5; 3]));
+        assert_eq!((half.lo, half.hi), ([63; 3], [64; 3]));
+        let empty = NormalBox::around(&Box32::EMPTY);
+        assert_eq!(empty, NormalBox::EMPTY);
+        assert!(empty.lo[0] > empty.hi[0]);
+    }
 
     /// Outward rounding never lands inside the value, and stays within one `f32` step.
     #[test]
@@ -1103,7 +1195,10 @@ mod tests {
                 .expect("a thread pool");
             let (tree, _) = pool.install(|| TriangleBvh::from_corners(corners.clone()));
             let bits = (tree.nodes.iter())
-                .flat_map(|n| [n.lo, n.hi, n.normal_lo, n.normal_hi])
+                .flat_map(|n| {
+                    let steps = [n.normal_lo, n.normal_hi].map(|a| a.map(|l| l.map(f32::from)));
+                    [n.lo, n.hi, steps[0], steps[1]]
+                })
                 .flatten()
                 .flatten()
                 .map(f32::to_bits)

@@ -13,13 +13,14 @@
 //! node an exact test would open (and perhaps a few more); the answer is decided at
 //! the leaves, by the exact `f64` test on the triangles.
 
-use super::bvh::{NodeStack, WideNode, PRUNE_FACTOR, WIDTH};
+use super::bvh::{NodeStack, WideNode, NORMAL_STEPS, PRUNE_FACTOR, WIDTH};
 use super::{cross, dot, length, sub, triangle_distance2, TriangleBvh, P3};
 
 /// How far above zero the `f32` lower bound of a dot product of unit vectors must be
 /// before a whole subtree counts as facing the same way. The rounding of the unit
-/// normals to `f32` and of the three products and two sums is below 1e-6; the margin is
-/// ten times that, so rounding never hides a triangle at right angles.
+/// normals to `f32`, of the boxes' steps back to `f32` (1/127 times a step count: one
+/// rounding, below 1e-7) and of the three products and two sums is below 1e-6; the
+/// margin is ten times that, so rounding never hides a triangle at right angles.
 const FACING_MARGIN: f32 = 1e-5;
 
 /// The shortest raw normal (of a query or of a triangle) that may skip a subtree by the
@@ -126,19 +127,19 @@ impl WideNode {
             least = [0.0; WIDTH];
             for k in 0..3 {
                 for i in 0..WIDTH {
-                    let bound = if u[k] >= 0.0 {
+                    let steps = if u[k] >= 0.0 {
                         self.normal_lo[k][i]
                     } else {
                         self.normal_hi[k][i]
                     };
-                    least[i] += u[k] * bound;
+                    least[i] += u[k] * (f32::from(steps) / NORMAL_STEPS);
                 }
             }
         }
         let mut mask = 0;
         for i in 0..WIDTH {
             // An empty normal box (zero-area triangles only) has nothing to say; its
-            // products are NaN or infinite, so it is told apart first.
+            // bounds cross, so it is told apart first.
             let all_face =
                 (self.normal_lo[0][i] > self.normal_hi[0][i]) | (least[i] > FACING_MARGIN);
             mask |= u32::from((apart[i] <= 0.0) & !all_face) << i;
@@ -157,7 +158,7 @@ fn unit_direction(v: P3) -> Option<[f32; 3]> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::bvh::Box32;
+    use super::super::bvh::{Box32, NormalBox};
     use super::*;
 
     /// Unused children, and children with no normals, are never opened; any other is
@@ -172,14 +173,11 @@ mod tests {
         let unit_box = Box32::around([0.0; 3], [1.0; 3]);
         // Child 0: normals around +z only; child 1: normals every way; child 2: no
         // normals (zero-area triangles only); child 3 unused (but with boxes set).
-        node.set_child(
-            0,
-            &unit_box,
-            &Box32::around([-0.1, -0.1, 0.9], [0.1, 0.1, 1.0]),
-        );
-        node.set_child(1, &unit_box, &Box32::around([-1.0; 3], [1.0; 3]));
-        node.set_child(2, &unit_box, &Box32::EMPTY);
-        node.set_child(3, &unit_box, &Box32::around([-1.0; 3], [1.0; 3]));
+        let normals = |lo, hi| NormalBox::around(&Box32::around(lo, hi));
+        node.set_child(0, &unit_box, &normals([-0.1, -0.1, 0.9], [0.1, 0.1, 1.0]));
+        node.set_child(1, &unit_box, &normals([-1.0; 3], [1.0; 3]));
+        node.set_child(2, &unit_box, &NormalBox::EMPTY);
+        node.set_child(3, &unit_box, &normals([-1.0; 3], [1.0; 3]));
         node.lanes = 3;
         let inside = ([0.4f32; 3], [0.6f32; 3]);
         let outside = ([2.0f32; 3], [3.0f32; 3]);
