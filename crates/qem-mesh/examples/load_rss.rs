@@ -1,7 +1,9 @@
 //! Reads one mesh file and prints what its arrays take, for measuring the readers' peak
 //! memory (`/usr/bin/time -f "%M KB %e s"`, BENCHMARKS.md "Loading"); or writes a UV
 //! sphere of about 2·N² triangles as a mesh file (binary PLY with `double` coordinates
-//! for `.ply`), to have a large input to read.
+//! for `.ply`), to have a large input to read; `noisy-sphere` gives its vertices a
+//! deterministic ±0.001 radial noise, as `scripts/make_uv_sphere.py` does (a large input
+//! to simplify: BENCHMARKS.md "A hundred million triangles").
 //!
 //! ```sh
 //! cargo run --release -p qem-mesh --features io --example load_rss -- sphere 6325 /tmp/s.ply
@@ -42,12 +44,13 @@ fn main() -> ExitCode {
                 ExitCode::FAILURE
             }
         },
-        ["sphere", n, out] => {
+        [kind @ ("sphere" | "noisy-sphere"), n, out] => {
             let Ok(n) = n.parse::<u32>() else {
                 eprintln!("N must be a whole number");
                 return ExitCode::FAILURE;
             };
-            match qem_mesh::io::write_path(Path::new(out), &sphere(n.max(3))) {
+            let noise = if kind == "noisy-sphere" { 0.001 } else { 0.0 };
+            match qem_mesh::io::write_path(Path::new(out), &sphere(n.max(3), noise)) {
                 Ok(()) => ExitCode::SUCCESS,
                 Err(e) => {
                     eprintln!("{e}");
@@ -56,24 +59,27 @@ fn main() -> ExitCode {
             }
         }
         _ => {
-            eprintln!("usage: load_rss read FILE | load_rss sphere N OUT");
+            eprintln!("usage: load_rss read FILE | load_rss [noisy-]sphere N OUT");
             ExitCode::FAILURE
         }
     }
 }
 
 /// `n - 1` rings of `n` vertices between two poles, as `scripts/make_uv_sphere.py`
-/// builds them (without its noise: the readers do not care).
-fn sphere(n: u32) -> IndexedMesh {
+/// builds them; the ring vertices at radius 1 ± `noise` (a deterministic hash of the
+/// vertex number, not the script's random sequence; 0 for the readers, which do not
+/// care, and so that the quadrics of a simplification are not all alike otherwise).
+fn sphere(n: u32, noise: f64) -> IndexedMesh {
     let mut positions = vec![[0.0, 0.0, 1.0]];
     for i in 1..n {
         let theta = std::f64::consts::PI * f64::from(i) / f64::from(n);
         for j in 0..n {
             let phi = 2.0 * std::f64::consts::PI * f64::from(j) / f64::from(n);
+            let r = 1.0 + noise * (2.0 * unit_hash(positions.len() as u64) - 1.0);
             positions.push([
-                theta.sin() * phi.cos(),
-                theta.sin() * phi.sin(),
-                theta.cos(),
+                r * theta.sin() * phi.cos(),
+                r * theta.sin() * phi.sin(),
+                r * theta.cos(),
             ]);
         }
     }
@@ -95,4 +101,13 @@ fn sphere(n: u32) -> IndexedMesh {
         triangles.push([south, at(n - 1, j + 1), at(n - 1, j)]);
     }
     IndexedMesh::new(positions, triangles)
+}
+
+/// A number in [0, 1) from `x` (SplitMix64's finaliser, Steele et al. 2014).
+fn unit_hash(x: u64) -> f64 {
+    let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    (z >> 11) as f64 / (1u64 << 53) as f64
 }
