@@ -67,8 +67,8 @@ fn main() -> ExitCode {
 
 /// `n - 1` rings of `n` vertices between two poles, as `scripts/make_uv_sphere.py`
 /// builds them; the ring vertices at radius 1 ± `noise` (a deterministic hash of the
-/// vertex number, not the script's random sequence; 0 for the readers, which do not
-/// care, and so that the quadrics of a simplification are not all alike otherwise).
+/// vertex number, not the script's random sequence). 0 for `sphere`: the readers do not
+/// care; the noise keeps a simplification's quadrics from all being alike.
 fn sphere(n: u32, noise: f64) -> IndexedMesh {
     let mut positions = vec![[0.0, 0.0, 1.0]];
     for i in 1..n {

@@ -2,11 +2,11 @@
 //! exact nearest-triangle queries (Metro sampling, the orientation check).
 //!
 //! Split as a binary tree would be (at median centroids), but stored as a 4-wide tree:
-//! each node holds its (up to) four children's boxes side by side in `f32`, by axis,
-//! two binary levels at once. Why: a walk reads one node (four cache lines) where it
-//! read four binary nodes in as many places, tests four boxes with the same
-//! instructions, and a node costs about 54 bytes per child instead of 56 for a binary
-//! node plus 48 for its normal box.
+//! each node holds its (up to) four children's boxes side by side, by axis (position
+//! boxes in `f32`, normal boxes in steps of 1/127: [`NormalBox`]), two binary levels at
+//! once. Why: a walk reads one node (three cache lines) where it read four binary nodes
+//! in as many places, tests four boxes with the same instructions, and a node costs 36
+//! bytes per child instead of 56 for a binary node plus 48 for its normal box.
 //!
 //! Long thin triangles are indexed in pieces (see [`pieces`]): a
 //! leaf entry is then a piece, which names its triangle, and a triangle may be met
@@ -132,8 +132,8 @@ impl Box32 {
 /// opens a node a little sooner, never skips one an exact box would open, so no answer
 /// changes. A wide node's normal boxes take 24 bytes instead of 96 (its size 144 bytes
 /// instead of 216; the orientation check's index holds one node for about six input
-/// triangles for the whole run: 12.6 bytes a triangle, BENCHMARKS.md "The budget,
-/// array by array").
+/// triangles for the whole run, so this saves 12.6 bytes a triangle, the nodes now
+/// costing about 25: BENCHMARKS.md "The budget, array by array").
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct NormalBox {
     pub lo: [i8; 3],
@@ -150,10 +150,11 @@ impl NormalBox {
         hi: [i8::MIN; 3],
     };
 
-    /// The least box of steps holding `bounds` (unit normals' bounds, so within a
-    /// rounding of ±1; a bound beyond ±128/127 is clamped, which the facing test's
-    /// margin covers for bounds that close to ±1). The product by 127 is exact in
-    /// `f64` (24 + 7 bits), so the floor and ceiling round outward exactly.
+    /// The least box of steps holding `bounds` (unit normals' bounds: each component
+    /// is `x / length` with `length ≥ |x|`, and rounding a value within ±1 outward to
+    /// `f32` keeps it within ±1, so no bound needs the clamp; were a high bound above 1,
+    /// it would clamp to 1, inside the facing test's margin). The product by 127 is
+    /// exact in `f64` (24 + 7 bits), so the floor and ceiling round outward exactly.
     pub fn around(bounds: &Box32) -> NormalBox {
         let step = |x: f32, round: fn(f64) -> f64| {
             round(f64::from(x) * f64::from(NORMAL_STEPS)).clamp(-128.0, 127.0) as i8
@@ -935,7 +936,8 @@ fn wide_node_count(n: usize) -> usize {
 }
 
 /// Sets the boxes of each child of each node: the box of its corners and the box of
-/// its unit normals, both rounded outward to `f32`. A triangle whose normal is shorter
+/// its unit normals, both rounded outward to `f32` (the normals' then to steps of 1/127,
+/// [`NormalBox::around`]). A triangle whose normal is shorter
 /// than [`MIN_PRUNING_LENGTH`] (but not zero), infinite or NaN counts as facing every
 /// way; a zero-area one has no direction and no say.
 ///
@@ -1011,6 +1013,13 @@ fn fill_boxes(nodes: &mut [WideNode], entry: impl Fn(usize) -> ([P3; 3], (P3, P3
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The node whose size the normal boxes' steps were chosen for (BENCHMARKS.md,
+    /// "The budget, array by array").
+    #[test]
+    fn a_wide_node_takes_144_bytes() {
+        assert_eq!(std::mem::size_of::<WideNode>(), 144);
+    }
 
     /// A box of normals in steps holds the bounds it was made from, is at most a step
     /// wider on each side, and stays empty when empty.

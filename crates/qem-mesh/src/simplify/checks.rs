@@ -5,8 +5,9 @@ use super::settings::Settings;
 use crate::clean::cross_underflows;
 use qem_core::{DVec3, Frame};
 
-/// Which way an input triangle faces, as the checks keep it: its unit normal in `f32`
-/// (zero for a triangle without area).
+/// Which way an input triangle faces, as the checks read it: its unit normal in `f32`
+/// (zero for a triangle without area); kept per triangle only without the orientation
+/// check's index, else computed from the index when asked (`InputFaces`).
 ///
 /// Why `f32`: the checks ask only the sign of its dot product with a moved face's
 /// normal (has the face turned more than 90° from the input face it descends from?),

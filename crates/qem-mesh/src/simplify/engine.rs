@@ -225,7 +225,9 @@ macro_rules! whole_slab_of {
 
 impl Engine {
     /// Face quadrics summed into vertex quadrics, border planes or locks, locked
-    /// vertices; `locked` lists cleaned-mesh indices.
+    /// vertices; `locked` lists cleaned-mesh indices. With the orientation check on,
+    /// also its index (built on the other core meanwhile), from which the input faces
+    /// are then read ([`InputFaces`]).
     pub fn new(
         cleaned: &IndexedMesh,
         frame: Frame,
@@ -526,26 +528,31 @@ impl Engine {
             is_live
         });
         let (position, triangles) = (&self.position, &self.triangles);
-        let with_planes = self.exact.is_some();
-        let (mut facing, mut planes) = (Vec::new(), Vec::new());
-        (0..count)
+        let skipped = |t: usize| is_live.as_ref().is_some_and(|live| !live[t]);
+        let corners = |t: usize| triangles[t].map(|c| position[c as usize]);
+        let facing = (0..count)
             .into_par_iter()
             .map(|t| {
-                if is_live.as_ref().is_some_and(|live| !live[t]) {
-                    return (Facing::default(), WeightedPlane::NONE);
+                if skipped(t) {
+                    return Facing::default();
                 }
-                let [pa, pb, pc] = triangles[t].map(|c| position[c as usize]);
-                let plane = if with_planes {
-                    weighted_plane(pa, pb, pc, area_offset)
-                } else {
-                    WeightedPlane::NONE
-                };
-                (Facing::of((pb - pa).cross(pc - pa)), plane)
+                let [pa, pb, pc] = corners(t);
+                Facing::of((pb - pa).cross(pc - pa))
             })
-            .unzip_into_vecs(&mut facing, &mut planes);
-        if !with_planes {
-            planes = Vec::new();
-        }
+            .collect();
+        let planes = match self.exact {
+            None => Vec::new(),
+            Some(_) => (0..count)
+                .into_par_iter()
+                .map(|t| {
+                    if skipped(t) {
+                        return WeightedPlane::NONE;
+                    }
+                    let [pa, pb, pc] = corners(t);
+                    weighted_plane(pa, pb, pc, area_offset)
+                })
+                .collect(),
+        };
         InputFaces::kept(facing, planes, area_offset)
     }
 }
@@ -684,8 +691,8 @@ impl Engine {
     /// order of the smaller end. Of the last pass's list, with its costs as computed
     /// (unpenalised), what this pass may reuse becomes `last_listed`.
     fn list_edges(&mut self) {
-        // Handed over rather than copied at costing time: the copy was 16 bytes an edge
-        // a pass, the first pass's onto fresh pages.
+        // The unpenalised costs are put back in place rather than the list copied at
+        // costing time (a copy was 16 bytes an edge a pass).
         for (i, cost) in self.unpenalised_costs.drain(..) {
             self.candidates[i as usize].cost = cost;
         }
@@ -1092,3 +1099,46 @@ mod speculation_tests;
 #[cfg(test)]
 #[path = "passes_blocks_tests.rs"]
 mod blocks_tests;
+
+#[cfg(test)]
+mod input_faces_tests {
+    use super::speculation_tests::thin_lens;
+    use super::*;
+
+    /// With the orientation check on, the engine reads every live triangle's facing and
+    /// face plane from the check's index, and they have the bits the setup's own
+    /// positions give (the kept faces): through the locality order, the index's leaf
+    /// order and its slots, on a mesh whose triangles come shuffled.
+    #[test]
+    fn faces_read_from_the_index_have_the_kept_bits() {
+        let mut mesh = thin_lens(12, 24);
+        // A fixed shuffle (a multiplicative step through the triangles).
+        let n = mesh.triangles.len();
+        let step = (0..n).map(|k| (k * 7919) % n).collect::<Vec<_>>();
+        assert!(n % 7919 != 0, "the step must be prime to the count");
+        mesh.triangles = step.iter().map(|&k| mesh.triangles[k]).collect();
+        let frame = Frame::from_points(mesh.positions.iter().map(|p| DVec3::from_array(*p)));
+        let engine = Engine::new(&mesh, frame, &[], &SimplifyOptions::default());
+        assert!(engine.input_faces.reads_from_index());
+        let kept = engine.kept_input_faces(engine.input_faces.area_offset());
+        assert!(!kept.reads_from_index());
+        let bits = |p: WeightedPlane| {
+            let [x, y, z] = p.normal.to_array();
+            [x, y, z, p.d, p.weight].map(f64::to_bits)
+        };
+        for &t in &engine.live {
+            let (read, kept_facing) = (engine.input_faces.facing(t), kept.facing(t));
+            assert_eq!(
+                read.normal().to_array().map(f64::to_bits),
+                kept_facing.normal().to_array().map(f64::to_bits),
+                "facing of {t}"
+            );
+            assert_eq!(
+                bits(engine.input_faces.plane(t)),
+                bits(kept.plane(t)),
+                "plane of {t}"
+            );
+        }
+        assert!(engine.live.len() > 100);
+    }
+}

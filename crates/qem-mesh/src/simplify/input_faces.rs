@@ -57,7 +57,8 @@ impl InputFaces {
     /// The input faces read from `index`: triangle `t`'s from triangle `slot[t]` of
     /// it, planes weighted with `area_offset`. `index` must hold the same triangles,
     /// in the loop's frame, corners in the same order. `None` when `slot` places a
-    /// triangle outside the index (an index leaves out triangles beyond its capacity).
+    /// triangle outside the index (an index built from a mesh gives every triangle a
+    /// slot, so this is a guard, not a case the engine meets).
     pub fn from_index(
         index: Arc<TriangleBvh>,
         slot: Vec<u32>,
@@ -101,6 +102,19 @@ impl InputFaces {
                 weighted_plane(a, b, c, self.area_offset)
             }
         }
+    }
+
+    /// The constant the face planes' weights add to their areas (`None`: unit
+    /// weights).
+    #[cfg(test)]
+    pub fn area_offset(&self) -> Option<f64> {
+        self.area_offset
+    }
+
+    /// Whether the faces are read from an index (rather than kept).
+    #[cfg(test)]
+    pub fn reads_from_index(&self) -> bool {
+        matches!(self.source, Source::Indexed { .. })
     }
 
     /// The quadric of input triangle `t`'s face plane.
