@@ -1141,4 +1141,43 @@ mod input_faces_tests {
         }
         assert!(engine.live.len() > 100);
     }
+
+    /// Of the last pass's list, exactly the edges with neither end moved in that pass
+    /// are kept, and `last_cost` answers for every edge of the new list what a search
+    /// of the whole last list under its rule would.
+    #[test]
+    fn the_last_list_keeps_exactly_the_reusable_costs() {
+        let mesh = thin_lens(12, 24);
+        let frame = Frame::from_points(mesh.positions.iter().map(|p| DVec3::from_array(*p)));
+        let mut engine = Engine::new(&mesh, frame, &[], &SimplifyOptions::default());
+        engine.pass = 1;
+        engine.list_edges();
+        engine.cost_edges();
+        let whole = engine.candidates.clone();
+        // Every third vertex moved in pass 1 (nothing else changed, so the new list
+        // is the same edges).
+        for v in (0..engine.moved_in.len()).step_by(3) {
+            engine.moved_in[v] = 1;
+        }
+        let moved = engine.moved_in.clone();
+        let unmoved = |c: &Candidate| moved[c.a as usize] != 1 && moved[c.b as usize] != 1;
+        let expected: Vec<(u32, u32, u64)> = (whole.iter().filter(|c| unmoved(c)))
+            .map(|c| (c.a, c.b, c.cost.to_bits()))
+            .collect();
+        assert!(!expected.is_empty() && expected.len() < whole.len());
+        engine.pass = 2;
+        engine.list_edges();
+        let kept: Vec<(u32, u32, u64)> = (engine.last_listed.iter())
+            .map(|c| (c.a, c.b, c.cost.to_bits()))
+            .collect();
+        assert_eq!(kept, expected);
+        assert_eq!(engine.candidates.len(), whole.len());
+        for c in &engine.candidates {
+            let searched = (whole.iter())
+                .find(|x| x.a == c.a && x.b == c.b)
+                .filter(|x| unmoved(x))
+                .map(|x| x.cost.to_bits());
+            assert_eq!(engine.last_cost(c.a, c.b).map(f64::to_bits), searched);
+        }
+    }
 }
