@@ -369,12 +369,10 @@ impl Engine {
         slots: &[u32],
         area_offset: Option<f64>,
     ) {
-        let hints = (self.triangle_from.iter().enumerate())
-            .map(|(t, &cleaned_t)| (t, slots[cleaned_t as usize]));
-        surface.seed_hints(hints);
-        let slot = (self.triangle_from.iter())
+        let slot: Vec<u32> = (self.triangle_from.iter())
             .map(|&cleaned_t| slots[cleaned_t as usize])
             .collect();
+        surface.seed_hints(slot.iter().copied().enumerate());
         self.input_faces = match InputFaces::from_index(surface.index(), slot, area_offset) {
             Some(faces) => faces,
             None => self.kept_input_faces(area_offset),
