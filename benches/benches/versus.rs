@@ -43,6 +43,10 @@
 //! `k` or `M`), or a mesh file path. The corpus is `$QEM_CORPUS` or `../shared/corpus`
 //! next to the workspace; corpus inputs are skipped with a message when it is absent.
 //!
+//! `--write-input PATH` writes the one `--input` (as loaded or built; the format
+//! follows the extension, `.ply` is binary) and times nothing: the procedural sphere
+//! as a file, for runs of the `qem simplify` process and of other tools on it.
+//!
 //! `--tool qem`, `--tool meshopt` or `--tool none` (load and weld only) run one tool,
 //! for peak-memory runs under `/usr/bin/time -v` on the bench binary
 //! (`cargo bench -p qem-bench --bench versus --no-run` prints its path): the tool's
@@ -98,10 +102,14 @@ struct Args {
     greedy: bool,
     /// qem's vertex clustering against `meshopt::simplify_sloppy`.
     cluster: bool,
+    /// Write the one input, as loaded or built, to this file and time nothing (for
+    /// runs of whole processes on the procedural sphere).
+    write_input: Option<PathBuf>,
 }
 
 const USAGE: &str = "usage: versus [--input dragon|soup|sphere:N|PATH]... [--ratios R,R...] \
-                     [--runs K] [--tool both|qem|meshopt|none|prep] [--fast [--orientation-check] [--exact] | --greedy | --cluster]";
+                     [--runs K] [--tool both|qem|meshopt|none|prep] [--fast [--orientation-check] [--exact] | --greedy | --cluster] \
+                     | --input INPUT --write-input PATH";
 
 fn parse_args() -> Result<Args, String> {
     let mut args = Args {
@@ -114,6 +122,7 @@ fn parse_args() -> Result<Args, String> {
         exact: false,
         greedy: false,
         cluster: false,
+        write_input: None,
     };
     let mut it = std::env::args().skip(1);
     while let Some(flag) = it.next() {
@@ -153,6 +162,7 @@ fn parse_args() -> Result<Args, String> {
             "--exact" => args.exact = true,
             "--greedy" => args.greedy = true,
             "--cluster" => args.cluster = true,
+            "--write-input" => args.write_input = Some(PathBuf::from(value()?)),
             "-h" | "--help" => return Err(USAGE.to_string()),
             other => return Err(format!("unknown argument {other:?}\n{USAGE}")),
         }
@@ -171,6 +181,9 @@ fn parse_args() -> Result<Args, String> {
         return Err(format!(
             "--greedy, --fast and --cluster exclude each other\n{USAGE}"
         ));
+    }
+    if args.write_input.is_some() && args.inputs.len() != 1 {
+        return Err(format!("--write-input needs exactly one --input\n{USAGE}"));
     }
     if args.inputs.is_empty() {
         args.inputs = vec!["dragon".into(), "sphere:4M".into(), "soup".into()];
@@ -457,6 +470,18 @@ fn time_prep(input: &str, raw: &IndexedMesh, runs: usize) -> Result<(), String> 
 
 fn run() -> Result<(), String> {
     let args = parse_args()?;
+    if let Some(path) = &args.write_input {
+        let input = &args.inputs[0];
+        let mesh = load(input)?.ok_or(format!("{input} is absent"))?;
+        qem_mesh::io::write_path(path, &mesh).map_err(|e| e.to_string())?;
+        eprintln!(
+            "{input}: {} triangles, {} vertices written to {}",
+            mesh.triangle_count(),
+            mesh.vertex_count(),
+            path.display()
+        );
+        return Ok(());
+    }
     let threads = std::env::var("RAYON_NUM_THREADS").unwrap_or_else(|_| "default".into());
     println!(
         "runs per figure: {} (median), RAYON_NUM_THREADS={threads}",
