@@ -160,7 +160,7 @@ impl Engine {
         let vanishes = self.settings.allow_merges && leaves_no_triangle(star);
         if vanishes {
             let corners = around.iter().flatten().flat_map(|x| x.corners);
-            error = error.max(farthest_corner(&self.position, corners, placed.position));
+            error = error.max(farthest_corner(&self.positions(), corners, placed.position));
         }
         let unchecked: &[u32] = if vanishes { merged } else { &[] };
         if error > self.settings.max_error_bound {
@@ -258,7 +258,7 @@ impl Engine {
         [merged, unchecked]: [&[u32]; 2],
     ) -> Result<(), Rejection> {
         plain_checks(
-            &self.corners_view(),
+            &self.positions(),
             &self.fixed(),
             [a, b],
             world,
@@ -319,6 +319,12 @@ impl Engine {
                 surface.set_hint(f.triangle as usize, t);
             }
         }
+        // The fields, not `positions`: the surface is borrowed meanwhile.
+        let positions = Positions {
+            first_vertex: 0,
+            frame: &self.frame,
+            world: &self.world,
+        };
         let moved = self.frame.to_normalized(world);
         // A triangle seen for the first time borrows the hint of the one checked before.
         let mut neighbour_hint = None;
@@ -334,7 +340,7 @@ impl Engine {
                 }
                 asked_again += 1;
             }
-            let new = moved_corners(&self.position, corners, [a, b], moved);
+            let new = moved_corners(&positions, corners, [a, b], moved);
             surface.agrees(x.triangle as usize, new, &mut neighbour_hint)
         });
         #[cfg(test)]
@@ -448,7 +454,7 @@ pub(super) fn misses_target(count: usize, target: usize) -> bool {
 /// The positions of a triangle's `corners` once the pair `ends` is contracted to
 /// `moved` (normalised units): either end goes to `moved`, the others stay.
 pub(super) fn moved_corners(
-    position: &[DVec3],
+    positions: &Positions,
     corners: [u32; 3],
     ends: [u32; 2],
     moved: DVec3,
@@ -457,7 +463,7 @@ pub(super) fn moved_corners(
         if ends.contains(&c) {
             moved
         } else {
-            position[c as usize]
+            positions.position(c)
         }
     })
 }

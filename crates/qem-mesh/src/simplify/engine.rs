@@ -32,7 +32,7 @@ use super::orientation::{InputSurface, Quick};
 use super::pair_set::PairSet;
 use super::pass_blocks::{
     border_neighbours, contract_block, merging_faces, plain_checks, shared_planes, Around,
-    BlockOutcome, Candidate, Corners, Fixed, Slab, WaiverChange, BLOCK_VERTICES, REMOVED,
+    BlockOutcome, Candidate, Fixed, Positions, Slab, WaiverChange, BLOCK_VERTICES, REMOVED,
 };
 use super::pass_exact::PassExact;
 use super::placement::place_merged;
@@ -70,14 +70,15 @@ pub(super) fn vanishing_cost(radius: f64, q: &Quadric) -> f64 {
     radius * radius * q.weight().max(0.0)
 }
 
-/// The largest distance from `at` to `corners` (vertex numbers into `position`).
+/// The largest distance from `at` to `corners` (vertex numbers; positions from
+/// `positions`).
 pub(super) fn farthest_corner(
-    position: &[DVec3],
+    positions: &Positions,
     corners: impl Iterator<Item = u32>,
     at: DVec3,
 ) -> f64 {
     corners
-        .map(|c| position[c as usize].distance(at))
+        .map(|c| positions.position(c).distance(at))
         .fold(0.0, f64::max)
 }
 
@@ -99,15 +100,14 @@ pub(super) struct Engine {
     pub frame: Frame,
     pub settings: Settings,
     pub counters: Counters,
-    /// World positions: a vertex that never moves keeps its input bits.
+    /// World positions: a vertex that never moves keeps its input bits. (Positions in
+    /// the normalised frame are computed from them when read: [`Positions`].)
     world: Vec<[f64; 3]>,
     /// The engine's arrays are in locality order ([`super::locality`]): for each
     /// vertex, its number in the cleaned mesh (for the output and the observer).
     vertex_from: Vec<u32>,
     /// For each triangle, its number in the cleaned mesh.
     triangle_from: Vec<u32>,
-    /// Positions in the normalised frame.
-    position: Vec<DVec3>,
     quadric: Vec<Quadric>,
     locked: Vec<bool>,
     /// Corners of every cleaned input triangle; [`REMOVED`] in the first corner once
@@ -213,7 +213,7 @@ macro_rules! whole_slab_of {
         Slab {
             first_vertex: 0,
             first_triangle: 0,
-            position: &mut $engine.position,
+            frame: &$engine.frame,
             world: &mut $engine.world,
             quadric: &mut $engine.quadric,
             moved_in: &mut $engine.moved_in,
@@ -268,11 +268,6 @@ impl Engine {
         } = in_locality_order(cleaned, &frame);
         let n = mesh.positions.len();
         let mesh_triangle_count = mesh.triangles.len();
-        let position: Vec<DVec3> = mesh
-            .positions
-            .par_iter()
-            .map(|p| frame.to_normalized(DVec3::from_array(*p)))
-            .collect();
         // The triangles the engine keeps: none with a repeated corner (it would
         // count as live while having no area), only the first of each vertex set (the
         // locality order keeps it first). Cleaning has dropped both when its passes
@@ -326,7 +321,6 @@ impl Engine {
             waivers: Waivers::new(n),
             exact: (options.quadrics == QuadricMode::Exact)
                 .then(|| PassExact::new(n, mesh_triangle_count)),
-            position,
             block_vertices: BLOCK_VERTICES,
             block_triangles: Vec::new(),
             deferred: Vec::new(),
@@ -344,7 +338,7 @@ impl Engine {
             &cleaned.attributes,
             &engine.triangles,
             &engine.triangle_from,
-            &engine.position,
+            &engine.positions(),
             &options.attribute_weights,
         );
         engine.add_seam_planes(options, area_offset);
@@ -388,7 +382,7 @@ impl Engine {
         if threshold.is_nan() || threshold <= 0.0 {
             return;
         }
-        let n = self.position.len();
+        let n = self.world.len();
         let part = (options.virtual_pairs == VirtualPairs::BetweenComponents).then(|| {
             let mut parent: Vec<usize> = (0..n).collect();
             for &t in &self.live {
@@ -400,7 +394,10 @@ impl Engine {
                 .map(|v| find(&mut parent, v) as u32)
                 .collect::<Vec<u32>>()
         });
-        let points: Vec<[f64; 3]> = self.position.iter().map(|p| p.to_array()).collect();
+        let positions = self.positions();
+        let points: Vec<[f64; 3]> = (0..n as u32)
+            .map(|v| positions.position(v).to_array())
+            .collect();
         let grid =
             GridOptions::new(threshold).with_max_per_vertex(options.max_virtual_pairs_per_vertex);
         let (incidence, triangles) = (&self.incidence, &self.triangles);
@@ -426,11 +423,11 @@ impl Engine {
         fixed_of!(self, None)
     }
 
-    /// Every vertex's positions, for the fold-over check.
-    fn corners_view(&self) -> Corners<'_> {
-        Corners {
+    /// Every vertex's positions.
+    pub(super) fn positions(&self) -> Positions<'_> {
+        Positions {
             first_vertex: 0,
-            position: &self.position,
+            frame: &self.frame,
             world: &self.world,
         }
     }
@@ -449,7 +446,7 @@ impl Engine {
     pub(super) fn set_block_vertices(&mut self, block_vertices: u32) {
         debug_assert_eq!(self.pass, 0);
         self.block_vertices = block_vertices.max(1);
-        let blocks = (self.position.len() as u32).div_ceil(self.block_vertices);
+        let blocks = (self.world.len() as u32).div_ceil(self.block_vertices);
         let triangles = &self.triangles;
         self.block_triangles = (0..=blocks)
             .map(|k| {
@@ -459,9 +456,16 @@ impl Engine {
             .collect();
     }
 
+    /// Vertex `v`'s position in the normalised frame.
+    #[inline]
+    pub(super) fn position(&self, v: u32) -> DVec3 {
+        self.positions().position(v)
+    }
+
     /// The corners of triangle `t` in the normalised frame.
     fn corners(&self, t: [u32; 3]) -> [DVec3; 3] {
-        t.map(|c| self.position[c as usize])
+        let positions = self.positions();
+        t.map(|c| positions.position(c))
     }
 
     /// Each vertex's quadric, summed from the weighted planes of the triangles along
@@ -492,13 +496,14 @@ impl Engine {
         // corners rather than once into an array: the array was 40 bytes a triangle at
         // the setup's memory peak, and with the orientation check on nothing keeps it
         // afterwards (`InputFaces` reads the planes from the check's index).
-        let (position, triangles, incidence) = (&self.position, &self.triangles, &self.incidence);
-        self.quadric = (0..self.position.len() as u32)
+        let positions = self.positions();
+        let (triangles, incidence) = (&self.triangles, &self.incidence);
+        self.quadric = (0..self.world.len() as u32)
             .into_par_iter()
             .map(|v| {
                 let mut sum = Quadric::default();
                 for &t in incidence.of(v) {
-                    let [pa, pb, pc] = triangles[t as usize].map(|c| position[c as usize]);
+                    let [pa, pb, pc] = triangles[t as usize].map(|c| positions.position(c));
                     sum += weighted_plane(pa, pb, pc, area_offset).quadric();
                 }
                 sum
@@ -525,9 +530,9 @@ impl Engine {
             }
             is_live
         });
-        let (position, triangles) = (&self.position, &self.triangles);
+        let (positions, triangles) = (self.positions(), &self.triangles);
         let skipped = |t: usize| is_live.as_ref().is_some_and(|live| !live[t]);
-        let corners = |t: usize| triangles[t].map(|c| position[c as usize]);
+        let corners = |t: usize| triangles[t].map(|c| positions.position(c));
         let facing = (0..count)
             .into_par_iter()
             .map(|t| {
@@ -560,7 +565,7 @@ impl Engine {
     /// triangle order (a counting sort of the live triangles' corners).
     fn list_incident_triangles(&mut self) {
         let (live, triangles) = (&self.live, &self.triangles);
-        self.incidence.rebuild(self.position.len(), || {
+        self.incidence.rebuild(self.world.len(), || {
             live.iter()
                 .flat_map(move |&t| triangles[t as usize].map(move |c| (c, t)))
         });
@@ -596,7 +601,7 @@ impl Engine {
             BoundaryMode::Locked => None,
         };
         // (smaller end, larger end, the edge's triangle)
-        let borders: Vec<(u32, u32, u32)> = (0..self.position.len() as u32)
+        let borders: Vec<(u32, u32, u32)> = (0..self.world.len() as u32)
             .into_par_iter()
             .map_init(Vec::new, |around, v| {
                 self.gather(v, around);
@@ -631,7 +636,8 @@ impl Engine {
     fn add_constraint_plane(&mut self, [v, x]: [u32; 2], t: u32, w: f64, area_offset: Option<f64>) {
         let [p0, p1, p2] = self.corners(self.triangles[t as usize]);
         let normal = (p1 - p0).cross(p2 - p0).normalize_or_zero();
-        let (pa, pb) = (self.position[v as usize], self.position[x as usize]);
+        let positions = self.positions();
+        let (pa, pb) = (positions.position(v), positions.position(x));
         let plane_weight = match area_offset {
             Some(extra) => w * (pa.distance_squared(pb) + extra),
             None => w,
@@ -657,7 +663,7 @@ impl Engine {
         if !(w > 0.0 && w.is_finite()) {
             return;
         }
-        let seams = wedges.seam_edges(&self.incidence, &self.triangles, self.position.len());
+        let seams = wedges.seam_edges(&self.incidence, &self.triangles, self.world.len());
         for (v, x, t) in seams {
             self.add_constraint_plane([v, x], t, w, area_offset);
         }
@@ -700,7 +706,7 @@ impl Engine {
         self.seen_with.fill(u32::MAX);
         self.candidates.clear();
         self.listed_first.clear();
-        for v in 0..self.position.len() as u32 {
+        for v in 0..self.world.len() as u32 {
             self.listed_first.push(self.candidates.len() as u32);
             for &t in self.incidence.of(v) {
                 for c in self.triangles[t as usize] {
@@ -862,8 +868,8 @@ impl Engine {
     /// a part that vanishes.
     fn place_on_quadrics(&self, a: u32, b: u32, q: Quadric) -> (Placement, Quadric) {
         let mut ends = [
-            (self.position[a as usize], self.locked[a as usize]),
-            (self.position[b as usize], self.locked[b as usize]),
+            (self.position(a), self.locked[a as usize]),
+            (self.position(b), self.locked[b as usize]),
         ];
         let Some(wedges) = &self.wedges else {
             return (place_merged(&q, ends, self.settings.placement), q);
@@ -951,7 +957,7 @@ impl Engine {
             return None;
         }
         let corners = live(a).chain(live(b)).flatten();
-        Some(farthest_corner(&self.position, corners, at))
+        Some(farthest_corner(&self.positions(), corners, at))
     }
 
     /// The geometric part of a placement's cost: the cost itself, or with attributes
@@ -1020,7 +1026,7 @@ impl Engine {
                 &self.live,
                 &self.triangles,
                 &self.triangle_from,
-                &self.position,
+                &self.positions(),
             );
         }
         let triangle_from: Vec<u32> = self

@@ -126,13 +126,13 @@ impl Engine {
                     .any(|&t| self.triangles[t as usize].contains(&other))
             })
             .collect();
-        greedy.pairs = PairSet::new(self.position.len(), ends);
+        greedy.pairs = PairSet::new(self.world.len(), ends);
         greedy.queue = PairQueue::new(candidates.len());
         for (id, c) in candidates.iter().enumerate() {
             greedy.queue.push(id as u32, c.cost);
         }
         greedy.filled = true;
-        greedy.shared_slot = vec![u32::MAX; self.position.len()];
+        greedy.shared_slot = vec![u32::MAX; self.world.len()];
         // The pass-based lists are not used again: their memory goes back.
         self.listed_first = Vec::new();
         self.seen_with = Vec::new();

@@ -15,8 +15,9 @@
 //! option works in both.
 //!
 //! Quadrics are computed in the normalised [`Frame`] of the cleaned input (coordinates
-//! in `[-1, 1]`), while world coordinates are kept beside them, so vertices that are
-//! never moved come out bit for bit as they went in.
+//! in `[-1, 1]`), while the engine keeps world coordinates (and computes a vertex's
+//! normalised position from them when it reads one), so vertices that are never moved
+//! come out bit for bit as they went in.
 //!
 //! Submodules, one job each: `options` (what a run may do), `settings` (options become
 //! what the engine reads, in one place), `report` and `counters` (what it did),

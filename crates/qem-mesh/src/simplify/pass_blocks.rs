@@ -95,15 +95,25 @@ pub(super) struct Fixed<'a> {
 }
 
 /// The positions of a run of vertices, read-only: what the fold-over check reads.
-pub(super) struct Corners<'a> {
+///
+/// Only world positions are kept; a vertex's position in the normalised frame is
+/// computed from its world one when read. Why: the engine wrote both from the same
+/// world point, so the normalised one was always `frame.to_normalized(world)`, bit for
+/// bit, and keeping it cost 24 bytes a vertex (12 a triangle) for the whole run.
+#[derive(Clone, Copy)]
+pub(super) struct Positions<'a> {
     pub first_vertex: u32,
-    pub position: &'a [DVec3],
+    pub frame: &'a Frame,
     pub world: &'a [[f64; 3]],
 }
 
-impl Corners<'_> {
-    fn position(&self, v: u32) -> DVec3 {
-        self.position[(v - self.first_vertex) as usize]
+impl Positions<'_> {
+    /// Vertex `v`'s position in the normalised frame.
+    #[inline]
+    pub fn position(&self, v: u32) -> DVec3 {
+        self.frame.to_normalized(DVec3::from_array(
+            self.world[(v - self.first_vertex) as usize],
+        ))
     }
 
     fn world(&self, v: u32) -> [f64; 3] {
@@ -167,7 +177,9 @@ impl Corners<'_> {
 pub(super) struct Slab<'a> {
     pub first_vertex: u32,
     pub first_triangle: u32,
-    pub position: &'a mut [DVec3],
+    /// The normalised frame: positions in it are computed from the world ones
+    /// ([`Positions`]).
+    pub frame: &'a Frame,
     pub world: &'a mut [[f64; 3]],
     pub quadric: &'a mut [Quadric],
     /// The pass in which each vertex last moved or was removed.
@@ -183,7 +195,7 @@ impl<'a> Slab<'a> {
     /// Vertex `v`'s place in the slices, if it is in the slab.
     fn vertex_slot(&self, v: u32) -> Option<usize> {
         let i = v.checked_sub(self.first_vertex)? as usize;
-        (i < self.position.len()).then_some(i)
+        (i < self.world.len()).then_some(i)
     }
 
     /// Triangle `t`'s place in `triangles`, if it is in the slab.
@@ -192,11 +204,11 @@ impl<'a> Slab<'a> {
         (i < self.triangles.len()).then_some(i)
     }
 
-    /// The fold-over check's read-only view of the slab.
-    pub fn corners(&self) -> Corners<'_> {
-        Corners {
+    /// The slab's vertex positions, read-only (what the fold-over check reads).
+    pub fn positions(&self) -> Positions<'_> {
+        Positions {
             first_vertex: self.first_vertex,
-            position: self.position,
+            frame: self.frame,
             world: self.world,
         }
     }
@@ -242,7 +254,6 @@ impl<'a> Slab<'a> {
         let (sa, sb) = (self.slot_of(a), self.slot_of(b));
         self.moved_in[sa] = fixed.pass;
         self.moved_in[sb] = fixed.pass;
-        self.position[sa] = fixed.frame.to_normalized(world);
         self.world[sa] = world.to_array();
         self.quadric[sa] = q;
         let mut removed = 0;
@@ -299,7 +310,8 @@ impl<'a> Slab<'a> {
                 if c == a || c == b {
                     moved
                 } else {
-                    self.position[(c - self.first_vertex) as usize]
+                    let world = self.world[(c - self.first_vertex) as usize];
+                    self.frame.to_normalized(DVec3::from_array(world))
                 }
             });
             let slot = (x.triangle - self.first_triangle) as usize;
@@ -314,7 +326,7 @@ impl<'a> Slab<'a> {
     pub fn into_blocks(self, block_vertices: u32, triangle_starts: &[u32]) -> Vec<Slab<'a>> {
         debug_assert_eq!((self.first_vertex, self.first_triangle), (0, 0));
         let Slab {
-            mut position,
+            frame,
             mut world,
             mut quadric,
             mut moved_in,
@@ -325,9 +337,7 @@ impl<'a> Slab<'a> {
         let mut blocks = Vec::with_capacity(triangle_starts.len().saturating_sub(1));
         for (k, bounds) in triangle_starts.windows(2).enumerate() {
             let first_vertex = k as u32 * block_vertices;
-            let count = (block_vertices as usize).min(position.len());
-            let (this_position, rest) = std::mem::take(&mut position).split_at_mut(count);
-            position = rest;
+            let count = (block_vertices as usize).min(world.len());
             let (this_world, rest) = std::mem::take(&mut world).split_at_mut(count);
             world = rest;
             let (this_quadric, rest) = std::mem::take(&mut quadric).split_at_mut(count);
@@ -344,7 +354,7 @@ impl<'a> Slab<'a> {
             blocks.push(Slab {
                 first_vertex,
                 first_triangle: bounds[0],
-                position: this_position,
+                frame,
                 world: this_world,
                 quadric: this_quadric,
                 moved_in: this_moved_in,
@@ -458,7 +468,11 @@ pub(super) fn contract_block(
             let triangles = (slab.first_triangle, &*slab.triangles);
             q -= shared_planes(fixed.incidence, triangles, exact, fixed.input_faces, [a, b]);
         }
-        let ends = [(slab.position[sa], false), (slab.position[sb], false)];
+        let positions = slab.positions();
+        let ends = [
+            (positions.position(a), false),
+            (positions.position(b), false),
+        ];
         let placed = place_merged(&q, ends, fixed.settings.placement);
         let error = q.rms_distance(placed.cost);
         if error > fixed.settings.max_error_bound {
@@ -473,8 +487,15 @@ pub(super) fn contract_block(
                 DVec3::from_array(slab.world[sa])
             }
         };
-        if let Err(why) = plain_checks(&slab.corners(), fixed, [a, b], world, shared, &around, &[])
-        {
+        if let Err(why) = plain_checks(
+            &slab.positions(),
+            fixed,
+            [a, b],
+            world,
+            shared,
+            &around,
+            &[],
+        ) {
             out.counters.reject(why);
             continue;
         }
@@ -538,10 +559,10 @@ pub(super) fn contract_block(
 
 /// The checks every contraction passes, in both orders and in the block workers:
 /// fold-over (degenerate, flipped, sliver; but not of the `unchecked` faces, see
-/// [`Corners::fold_over`]), merged faces, border loops, topology. (The lock check and
+/// [`Positions::fold_over`]), merged faces, border loops, topology. (The lock check and
 /// the orientation check are the sequential attempts' own.)
 pub(super) fn plain_checks(
-    corners: &Corners,
+    positions: &Positions,
     fixed: &Fixed,
     [a, b]: [u32; 2],
     world: DVec3,
@@ -549,7 +570,7 @@ pub(super) fn plain_checks(
     around: &[Vec<Around>; 2],
     unchecked: &[u32],
 ) -> Result<(), Rejection> {
-    corners.fold_over(fixed, [a, b], world, around, unchecked)?;
+    positions.fold_over(fixed, [a, b], world, around, unchecked)?;
     if !fixed.settings.allow_merges && would_merge_faces(a, b, around) {
         return Err(Rejection::Merge);
     }

@@ -170,7 +170,7 @@ impl Engine {
             && !self.settings.allow_merges
             && self.wedges.is_none()
             && hints_per_triangle
-            && self.position.len() > self.block_vertices as usize
+            && self.world.len() > self.block_vertices as usize
     }
 
     /// Contracts the pairs of `selected` (a round, in list order) that are interior to
@@ -621,6 +621,12 @@ impl Engine {
         // The other checks are not asked first: in a pass that speculates, they refuse
         // few pairs (see `speculating`), and asking them here too would double their
         // cost for all.
+        // The fields, not `positions`: the surface is borrowed meanwhile.
+        let positions = Positions {
+            first_vertex: 0,
+            frame: &self.frame,
+            world: &self.world,
+        };
         let moved = self.frame.to_normalized(world);
         let mut neighbour_hint = None;
         for x in around.iter().flatten() {
@@ -628,7 +634,7 @@ impl Engine {
             if corners.contains(&a) && corners.contains(&b) {
                 continue;
             }
-            let new = moved_corners(&self.position, corners, [a, b], moved);
+            let new = moved_corners(&positions, corners, [a, b], moved);
             // Only the quick tests: a full search here would start from the hints as
             // they were, which the attempts before this one may have moved on (on CAD
             // meshes, where full searches are common and dear, asking them here made
@@ -654,7 +660,7 @@ impl Engine {
     #[cfg(test)]
     fn interior_first(&self, selected: &[u32], order: &mut Vec<u32>) {
         let layout_block = |v: u32| v / self.block_vertices;
-        let n = self.position.len() as u32;
+        let n = self.world.len() as u32;
         let interior = |i: u32| {
             let Candidate { a, b, .. } = self.candidates[i as usize];
             let k = layout_block(a);

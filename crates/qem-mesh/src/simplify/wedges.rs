@@ -35,7 +35,7 @@
 use super::checks::Rejection;
 use super::incidence::Incidence;
 use super::options::AttributeWeights;
-use super::pass_blocks::{Around, REMOVED};
+use super::pass_blocks::{Around, Positions, REMOVED};
 use crate::attributes::{Attributes, Channel, ChannelKind, FaceLabels};
 use qem_core::{AttributeQuadric, DVec3, Quadric};
 use smallvec::SmallVec;
@@ -132,14 +132,14 @@ pub(super) enum Pin {
 
 impl Wedges {
     /// The wedges of the engine's triangles `triangles` (engine numbering, each from
-    /// the cleaned triangle `triangle_from[t]`), positions `position` (normalised),
+    /// the cleaned triangle `triangle_from[t]`), vertex positions from `positions`,
     /// with the cleaned mesh's `attributes`; `None` for a mesh without channels or
     /// materials.
     pub fn new(
         attributes: &Attributes,
         triangles: &[[u32; 3]],
         triangle_from: &[u32],
-        position: &[DVec3],
+        positions: &Positions,
         weights: &AttributeWeights,
     ) -> Option<Wedges> {
         if attributes.channels.is_empty() && attributes.materials.is_empty() {
@@ -202,7 +202,7 @@ impl Wedges {
                     idx.map(|i| c.value(i).iter().map(|&x| f64::from(x)).collect());
                 let mut one = AttributeQuadric::new(c.dimension);
                 one.add_triangle(
-                    tri.map(|v| position[v as usize]),
+                    tri.map(|v| positions.position(v)),
                     [&values[0], &values[1], &values[2]],
                 );
                 for &wedge in &set.corner[t] {
@@ -339,15 +339,15 @@ impl Wedges {
     }
 
     /// The attributes of the output: for the engine's `live` triangles (each from the
-    /// cleaned triangle `triangle_from[t]`), with `position` (normalised) of each
-    /// vertex. Each channel's values are listed once per wedge used, in order of first
+    /// cleaned triangle `triangle_from[t]`), with the position of each vertex from
+    /// `positions`. Each channel's values are listed once per wedge used, in order of first
     /// use.
     pub fn output(
         &self,
         live: &[u32],
         triangles: &[[u32; 3]],
         triangle_from: &[u32],
-        position: &[DVec3],
+        positions: &Positions,
     ) -> Attributes {
         let channels = self
             .sets
@@ -373,7 +373,7 @@ impl Wedges {
                         let next = (out.values.len() / c.dimension) as u32;
                         *number.entry(wedge).or_insert_with(|| {
                             out.values
-                                .extend(self.value(set, wedge, position[tri[k] as usize]));
+                                .extend(self.value(set, wedge, positions.position(tri[k])));
                             next
                         })
                     });
