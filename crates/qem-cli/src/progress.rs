@@ -10,7 +10,7 @@
 //! nothing is drawn, so logs get no escape codes.
 
 use indicatif::{ProgressBar, ProgressStyle};
-use qem_mesh::simplify::{Observer, Progress};
+use qem_mesh::simplify::{Observer, Phase, Progress};
 use std::io::IsTerminal;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
@@ -38,7 +38,7 @@ pub fn bars_wanted(quiet: bool) -> bool {
 }
 
 /// A bar over the contraction loop of one mesh (per mille of the work), hidden unless
-/// `visible`.
+/// `visible`; it says `reading…` until the caller's observer names the next stage.
 pub fn simplify_bar(visible: bool, name: &str) -> ProgressBar {
     if !visible {
         return ProgressBar::hidden();
@@ -50,6 +50,7 @@ pub fn simplify_bar(visible: bool, name: &str) -> ProgressBar {
             .progress_chars("=> "),
     );
     bar.set_prefix(name.to_string());
+    bar.set_message("reading…");
     bar.enable_steady_tick(Duration::from_millis(200));
     bar
 }
@@ -96,6 +97,13 @@ impl Observer for BarObserver<'_> {
 
     fn should_stop(&mut self) -> bool {
         interrupted()
+    }
+
+    /// Each stage is named as it begins (the ones before the loop's first report take a
+    /// while on a large mesh, the bar sitting at 0% meanwhile); the loop's progress then
+    /// replaces the name.
+    fn phase(&mut self, phase: Phase) {
+        self.bar.set_message(format!("{}…", phase.name()));
     }
 
     fn wants_contractions(&self) -> bool {

@@ -9,8 +9,8 @@ use crate::report::{write_json_atomically, AttributesJson, LevelJson, LevelsJson
 use clap::Args;
 use qem_mesh::io::{read_path, write_path, Format, ReadNotes};
 use qem_mesh::simplify::{
-    simplify_levels_owned, simplify_owned, Observer, Simplified, SimplifyOptions, StopReason,
-    Target,
+    simplify_levels_owned, simplify_owned, Observer, Simplified, SimplifyError, SimplifyOptions,
+    StopReason, Target,
 };
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -101,8 +101,7 @@ pub fn simplify_file(
     let input_attributes = AttributesJson::names(&mesh.attributes);
     let clock = Instant::now();
     // Handed over: the engine drops it once cleaned (see `simplify_owned`).
-    let result = simplify_owned(mesh, options, observer)
-        .map_err(|e| Failure::Failed(format!("{}: {e}", input.display())))?;
+    let result = simplify_owned(mesh, options, observer).map_err(|e| simplify_failure(input, e))?;
     let simplify_time = clock.elapsed();
     if result.report.stop_reason == StopReason::Cancelled || interrupted() {
         return Err(Failure::Interrupted);
@@ -147,6 +146,15 @@ fn attributes_of(input: Vec<String>, result: &Simplified, output: &Path) -> Attr
     // The output's name was checked before it was written, so it has a format.
     let format = Format::from_path(output).unwrap_or(Format::Obj);
     AttributesJson::new(input, &result.mesh.attributes, format)
+}
+
+/// The failure of simplifying `input`: Ctrl-C pressed before the loop began is an
+/// interruption (see `Observer::should_stop`), anything else an error naming the file.
+fn simplify_failure(input: &Path, e: SimplifyError) -> Failure {
+    match e {
+        SimplifyError::Cancelled { .. } => Failure::Interrupted,
+        e => Failure::Failed(format!("{}: {e}", input.display())),
+    }
 }
 
 fn load(input: &Path) -> Result<(qem_mesh::IndexedMesh, ReadNotes, Duration), Failure> {
@@ -203,7 +211,7 @@ fn run_levels(args: &SimplifyArgs) -> Result<(), Failure> {
             &targets,
             &mut BarObserver::new(&bar),
         )
-        .map_err(|e| Failure::Failed(format!("{}: {e}", args.input.display())))?;
+        .map_err(|e| simplify_failure(&args.input, e))?;
         Ok((input_attributes, levels, notes, load, clock.elapsed()))
     })();
     bar.finish_and_clear();

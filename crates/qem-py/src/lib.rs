@@ -28,8 +28,8 @@ use pyo3::types::{PyBool, PyDict, PyList, PyString, PyTuple};
 use qem_mesh::clean::CleanOptions;
 use qem_mesh::measure::{MeasureOptions, Measurement};
 use qem_mesh::simplify::{
-    BoundaryMode, ContractionOrder, Length, Method, Observer, PlacementMode, Progress, QuadricMode,
-    SimplifyOptions, SimplifyReport, Target, VirtualPairs, Weighting,
+    BoundaryMode, ContractionOrder, Length, Method, Observer, Phase, PlacementMode, Progress,
+    QuadricMode, SimplifyOptions, SimplifyReport, Target, VirtualPairs, Weighting,
 };
 use qem_mesh::IndexedMesh;
 use std::path::PathBuf;
@@ -810,6 +810,18 @@ impl Observer for PyObserver {
 
     fn should_stop(&mut self) -> bool {
         self.cancelled || self.error.is_some()
+    }
+
+    /// Ctrl-C is checked as each stage begins too: the cleaning and the setup of a large
+    /// mesh take a while before the loop's first poll, and the run stops at their end.
+    fn phase(&mut self, _phase: Phase) {
+        if self.error.is_none() {
+            Python::attach(|py| {
+                if let Err(e) = py.check_signals() {
+                    self.error = Some(e);
+                }
+            });
+        }
     }
 
     fn wants_contractions(&self) -> bool {

@@ -57,7 +57,7 @@ mod settings;
 mod waivers;
 mod wedges;
 
-pub use observer::{Contraction, NoObserver, Observer, Progress};
+pub use observer::{Contraction, NoObserver, Observer, Phase, Progress};
 pub use options::{
     AttributeWeights, BoundaryMode, ContractionOrder, Length, Method, PlacementMode, QuadricMode,
     SimplifyOptions, Target, VirtualPairs, Weighting, DEFAULT_BOUNDARY_WEIGHT,
@@ -225,6 +225,7 @@ fn levels_of(
             vertex_count: mesh.vertex_count(),
         });
     }
+    observer.phase(Phase::Cleaning);
     let cleaned = clean(&mesh, &options.clean);
     // Locked input vertices, renumbered like the cleaned mesh (unreferenced ones drop).
     let locked: Vec<u32> = options
@@ -241,11 +242,22 @@ fn levels_of(
         return Err(SimplifyError::NothingLeftAfterCleaning { triangles_in });
     }
     timings.clean = clock.elapsed();
+    if observer.should_stop() {
+        return Err(SimplifyError::Cancelled {
+            after: Phase::Cleaning,
+        });
+    }
 
     let frame = Frame::from_points(cleaned.mesh.positions.iter().map(|p| DVec3::from_array(*p)));
     let clock = Instant::now();
+    observer.phase(Phase::SettingUp);
     let mut engine = Engine::new(&cleaned.mesh, frame, &locked, options);
     timings.setup = clock.elapsed();
+    if observer.should_stop() {
+        return Err(SimplifyError::Cancelled {
+            after: Phase::SettingUp,
+        });
+    }
     observer.cleaned(&cleaned.mesh, &frame);
     // The loop needs the cleaned mesh no more: gone before it starts (about 120 MB on
     // a 4M-triangle mesh), since it runs far longer than the setup and holds the most.
@@ -256,6 +268,7 @@ fn levels_of(
     for &level in levels {
         let target_triangles = target_count(level, triangles_in);
         let clock = Instant::now();
+        observer.phase(Phase::Contracting);
         let stop_reason = match stopped_short {
             Some(reason) => reason,
             None => engine.run_order_with_ladder(options, target_triangles, observer),
@@ -266,6 +279,7 @@ fn levels_of(
         timings.contract += clock.elapsed();
 
         let clock = Instant::now();
+        observer.phase(Phase::Compacting);
         let mut raw = engine.to_mesh();
         // Zero area is judged in the loop's frame, not in the output's own (see
         // `checks::is_zero_area`): the loop refused every contraction that would make a

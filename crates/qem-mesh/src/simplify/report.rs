@@ -147,6 +147,14 @@ pub enum SimplifyError {
         /// `locked_vertices`, `boundary: Locked`, `max_error`, `target: None`).
         option: &'static str,
     },
+    /// The observer asked to stop ([`Observer::should_stop`](super::Observer::should_stop))
+    /// before the contraction loop began: there is no partial result yet. (Asked
+    /// during the loop, the run ends with
+    /// [`StopReason::Cancelled`](super::StopReason::Cancelled) and a valid mesh.)
+    Cancelled {
+        /// The phase that had just ended.
+        after: super::Phase,
+    },
 }
 
 impl fmt::Display for SimplifyError {
@@ -171,6 +179,13 @@ impl fmt::Display for SimplifyError {
                 "vertex clustering cannot honour {option}: it places one vertex per grid \
                  cell and reaches a triangle count, nothing else"
             ),
+            SimplifyError::Cancelled { after } => {
+                write!(
+                    f,
+                    "cancelled after {}, before any contraction",
+                    after.name()
+                )
+            }
         }
     }
 }

@@ -232,8 +232,10 @@ fn observer_sees_progress_and_can_cancel() {
         fn progress(&mut self, p: Progress) {
             self.0.push(p);
         }
+        // Once the loop has reported (asked before it, at the ends of the cleaning
+        // and the setup, a stop would end the run with no partial result).
         fn should_stop(&mut self) -> bool {
-            true
+            !self.0.is_empty()
         }
     }
     // 16,128 triangles: the observer is polled after 4,096 attempts, which in the
@@ -257,6 +259,61 @@ fn observer_sees_progress_and_can_cancel() {
             "{order:?}: a report when polled and one at the end"
         );
         assert!(observer.0[0].fraction() > 0.0 && observer.0[0].fraction() < 1.0);
+    }
+}
+
+/// The observer hears each phase as it begins, in order (the loop's and the
+/// compaction's once per level), and a stop asked at the end of the cleaning or of the
+/// setup ends the run there, with an error naming the phase (no partial result).
+#[test]
+fn observer_sees_the_phases_and_can_cancel_before_the_loop() {
+    use qem_mesh::simplify::{simplify_levels, Observer, Phase, SimplifyError};
+    struct Phases {
+        seen: Vec<Phase>,
+        stop_after: Option<Phase>,
+    }
+    impl Observer for Phases {
+        fn phase(&mut self, phase: Phase) {
+            self.seen.push(phase);
+        }
+        fn should_stop(&mut self) -> bool {
+            self.stop_after.is_some() && self.seen.last().copied() == self.stop_after
+        }
+    }
+    let sphere = uv_sphere([0.0; 3], 1.0, 16, 32);
+    let levels = [Target::Ratio(0.5), Target::Ratio(0.25)];
+    let mut all = Phases {
+        seen: Vec::new(),
+        stop_after: None,
+    };
+    let out = simplify_levels(&sphere, &SimplifyOptions::DEFAULT, &levels, &mut all).unwrap();
+    assert_eq!(out.len(), 2);
+    use Phase::*;
+    assert_eq!(
+        all.seen,
+        [
+            Cleaning,
+            SettingUp,
+            Contracting,
+            Compacting,
+            Contracting,
+            Compacting
+        ]
+    );
+    for phase in [Cleaning, SettingUp] {
+        let mut stopping = Phases {
+            seen: Vec::new(),
+            stop_after: Some(phase),
+        };
+        let err = simplify_levels(&sphere, &SimplifyOptions::DEFAULT, &levels, &mut stopping)
+            .unwrap_err();
+        assert_eq!(err, SimplifyError::Cancelled { after: phase });
+        assert_eq!(
+            stopping.seen.last(),
+            Some(&phase),
+            "nothing after {phase:?}"
+        );
+        assert!(err.to_string().contains(phase.name()), "{err}");
     }
 }
 
