@@ -319,12 +319,8 @@ impl Engine {
                 surface.set_hint(f.triangle as usize, t);
             }
         }
-        // The fields, not `positions`: the surface is borrowed meanwhile.
-        let positions = Positions {
-            first_vertex: 0,
-            frame: &self.frame,
-            world: &self.world,
-        };
+        // From the fields, not `self.positions()`: the surface is borrowed meanwhile.
+        let positions = Positions::whole(&self.frame, &self.world);
         let moved = self.frame.to_normalized(world);
         // A triangle seen for the first time borrows the hint of the one checked before.
         let mut neighbour_hint = None;

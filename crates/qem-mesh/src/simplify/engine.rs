@@ -425,11 +425,7 @@ impl Engine {
 
     /// Every vertex's positions.
     pub(super) fn positions(&self) -> Positions<'_> {
-        Positions {
-            first_vertex: 0,
-            frame: &self.frame,
-            world: &self.world,
-        }
+        Positions::whole(&self.frame, &self.world)
     }
 
     /// The whole mesh as one [`Slab`] (for the sequential attempts), and what does not

@@ -107,7 +107,16 @@ pub(super) struct Positions<'a> {
     pub world: &'a [[f64; 3]],
 }
 
-impl Positions<'_> {
+impl<'a> Positions<'a> {
+    /// Every vertex's positions: `world` holds them from vertex 0 on.
+    pub fn whole(frame: &'a Frame, world: &'a [[f64; 3]]) -> Self {
+        Positions {
+            first_vertex: 0,
+            frame,
+            world,
+        }
+    }
+
     /// Vertex `v`'s position in the normalised frame.
     #[inline]
     pub fn position(&self, v: u32) -> DVec3 {

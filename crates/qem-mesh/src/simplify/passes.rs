@@ -621,12 +621,7 @@ impl Engine {
         // The other checks are not asked first: in a pass that speculates, they refuse
         // few pairs (see `speculating`), and asking them here too would double their
         // cost for all.
-        // The fields, not `positions`: the surface is borrowed meanwhile.
-        let positions = Positions {
-            first_vertex: 0,
-            frame: &self.frame,
-            world: &self.world,
-        };
+        let positions = self.positions();
         let moved = self.frame.to_normalized(world);
         let mut neighbour_hint = None;
         for x in around.iter().flatten() {
