@@ -372,7 +372,7 @@ pub(crate) enum Slot {
     Left(&'static str),
 }
 
-/// Where [`write`] puts each of `channels`: the first normals, the first colour that
+/// Where [`write()`] puts each of `channels`: the first normals, the first colour that
 /// is not per face and the first texture coordinates on the vertices (NOFF, COFF,
 /// STOFF), the first colour with one value per triangle on the faces (see
 /// [`colours_on_faces`] for two of them); nothing else has a place in OFF.

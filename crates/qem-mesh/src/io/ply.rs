@@ -1363,7 +1363,7 @@ pub(crate) enum Placement {
     Left(&'static str),
 }
 
-/// Where [`write`] puts each of `channels`: the first texture coordinates as `s t`, the
+/// Where [`write()`] puts each of `channels`: the first texture coordinates as `s t`, the
 /// first normals as `nx ny nz`, the first colour with one value per triangle as the
 /// faces' `red green blue [alpha]` and the first other colour as the vertices' (of two
 /// colours that both have one value per triangle, the first goes on the vertices:

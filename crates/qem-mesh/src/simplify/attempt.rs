@@ -287,7 +287,7 @@ impl Engine {
 
     /// Whether every triangle that contracting `b` into `a` at `world` moves faces the
     /// same way as the input surface nearest to its new centroid (see
-    /// [`super::orientation`]); true when the check is off. Triangles on both `a` and
+    /// [`crate::simplify::orientation`]); true when the check is off. Triangles on both `a` and
     /// `b` collapse and are not asked, nor are the `unchecked` ones (merged faces of a
     /// part that vanishes).
     ///

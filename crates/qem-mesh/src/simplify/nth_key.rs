@@ -1,5 +1,5 @@
 //! The `rank`-th smallest of a list of distinct keys, on the thread pool: what bounds
-//! each pass's batch ([`super::passes`]).
+//! each pass's batch ([`crate::simplify::engine`]'s pass-based order).
 //!
 //! Why not `select_nth_unstable` on a copy of the keys: on the 6M edges of the first
 //! pass over a 4M-triangle mesh that was 83 ms on one core, with 96 MB of keys written

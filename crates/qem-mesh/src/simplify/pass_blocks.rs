@@ -248,7 +248,7 @@ impl<'a> Slab<'a> {
 
     /// Contracts `b` into `a`, which moves to `world` (model units) with quadric `q`;
     /// `around` holds the live triangles of `a` and of `b`, and `merged` the faces that
-    /// the contraction merges and that go with it (see [`Engine::merged_away`]).
+    /// the contraction merges and that go with it (see `Engine::merged_away`).
     /// Returns how many triangles were removed. (Exact quadrics' planes and the
     /// orientation check's state are the caller's.)
     pub fn contract(

@@ -21,21 +21,21 @@
 //!    until the batch is empty or the target is reached. Without locks, and far from
 //!    the target, the pairs of a round whose neighbourhoods lie inside one block of
 //!    vertex numbers are attempted first, the blocks on the thread pool, and the rest
-//!    after them in order ([`super::pass_blocks`]). With the orientation check on, a
+//!    after them in order ([`crate::simplify::pass_blocks`]). With the orientation check on, a
 //!    chunk of the pairs attempted in order may first be *speculated* on the thread pool
 //!    (their placements and the check's quick tests, against the arrays as they are;
 //!    when most recent attempts contracted), and the attempts take what still holds
 //!    ([`Engine::speculate`] says why that is the sequential answer, bit for bit).
 //!
-//! Why it is faster than [`ContractionOrder::Greedy`](super::ContractionOrder::Greedy):
+//! Why it is faster than [`ContractionOrder::Greedy`](crate::simplify::ContractionOrder::Greedy):
 //! no heap, each pair costed at most once per pass, the contractions walk the arrays
 //! in order, and much of the work is on both cores. What it gives up: the strict
 //! greedy order (a pair whose cost fell during a pass waits for the next one). Virtual
 //! pairs are listed with the edges of their smaller end (and go to the sequential
 //! attempts, not the blocks). Exact quadrics keep their planes as
-//! [`super::pass_exact`] describes. The orientation check runs last among the checks;
+//! [`crate::simplify::pass_exact`] describes. The orientation check runs last among the checks;
 //! a pair it refuses is ranked at the waivers' penalty in later passes and then tried
-//! without it ([`super::waivers`]).
+//! without it ([`crate::simplify::waivers`]).
 //!
 //! If a pass contracts nothing, its batch grows fourfold (without the pairs already
 //! refused) until every edge has been tried; a pass that still contracts nothing ends
@@ -155,7 +155,7 @@ pub(super) struct FaceAgrees {
 }
 
 impl Engine {
-    /// Whether rounds are contracted block by block ([`super::pass_blocks`]): not with
+    /// Whether rounds are contracted block by block ([`crate::simplify::pass_blocks`]): not with
     /// locks (the lock check reads a locked neighbour's triangles, which may lie
     /// outside the block), and only with more than one block.
     fn uses_blocks(&self) -> bool {

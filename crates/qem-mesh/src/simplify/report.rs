@@ -149,8 +149,7 @@ pub enum SimplifyError {
     },
     /// The observer asked to stop ([`Observer::should_stop`](super::Observer::should_stop))
     /// before the contraction loop began: there is no partial result yet. (Asked
-    /// during the loop, the run ends with
-    /// [`StopReason::Cancelled`](super::StopReason::Cancelled) and a valid mesh.)
+    /// during the loop, the run ends with [`StopReason::Cancelled`] and a valid mesh.)
     Cancelled {
         /// The phase that had just ended.
         after: super::Phase,
