@@ -664,27 +664,61 @@ mod tests {
         [&data[..at], new, &data[at + old.len()..]].concat()
     }
 
+    /// The inputs that [`cases`] varies (gzipped, twice gzipped, with more after).
+    fn bases() -> Vec<(&'static str, Vec<u8>, Format)> {
+        let ascii =
+            b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+            property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n\
+            0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"
+                .to_vec();
+        let mut bases = vec![
+            ("written", written_ply(), Format::Ply),
+            ("big endian", big_endian_ply(), Format::Ply),
+            ("long header", long_header_ply(), Format::Ply),
+            ("ascii", ascii, Format::Ply),
+            ("stl", written_stl(b"binary"), Format::Stl),
+            ("stl solid", written_stl(b"solid but binary"), Format::Stl),
+        ];
+        bases.extend(text_bases());
+        bases
+    }
+
+    /// Text files whose lines straddle chunks: comments, line ends, a byte order mark,
+    /// bytes that are not UTF-8, no final line break, a line longer than a chunk.
+    fn text_bases() -> Vec<(&'static str, Vec<u8>, Format)> {
+        let long_comment = format!("# {}\n", "long ".repeat(2000));
+        vec![
+            (
+                "off",
+                b"OFF\n# a comment\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n".to_vec(),
+                Format::Off,
+            ),
+            (
+                "coff, bom, crlf, latin-1, no final line break",
+                b"\xEF\xBB\xBFCOFF\r\n# caf\xe9\r\n\r\n4 1 0\r\n0 0 0 255 0 0\r\n1 0 0 0 255 0\r\n\
+                  1 1 0 0 0 255 # blue\r\n0 1 0 9 9 9\r\n4 0 1 2 3 1 0 0\r\nafter \xff\r\nmore"
+                    .to_vec(),
+                Format::Off,
+            ),
+            (
+                "off, counts on their own line, a long comment",
+                format!(
+                    "{long_comment}NOFF\n{long_comment}3 1\n0 0 0 0 0 1\n1 0 0 0 0 1\n\
+                     0 1 0 0 0 1\n{long_comment}3 0 1 2"
+                )
+                .into_bytes(),
+                Format::Off,
+            ),
+        ]
+    }
+
     /// Every input and its variants, named.
     fn cases() -> Vec<(String, Vec<u8>, Format)> {
         let mut cases = Vec::new();
         let ply = written_ply();
         let big = big_endian_ply();
         let stl = written_stl(b"binary");
-        let stl_solid = written_stl(b"solid but binary");
-        let ascii =
-            b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
-            property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n\
-            0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"
-                .to_vec();
-        let bases = [
-            ("written", ply.clone(), Format::Ply),
-            ("big endian", big.clone(), Format::Ply),
-            ("long header", long_header_ply(), Format::Ply),
-            ("ascii", ascii, Format::Ply),
-            ("stl", stl.clone(), Format::Stl),
-            ("stl solid", stl_solid, Format::Stl),
-        ];
-        for (name, data, format) in bases {
+        for (name, data, format) in bases() {
             cases.push((format!("{name} gzipped"), gzip(&data), format));
             cases.push((
                 format!("{name} twice gzipped"),
@@ -806,7 +840,7 @@ mod tests {
     /// sizes in turn.
     #[test]
     fn every_truncation_gives_what_memory_gives() {
-        for (name, data, format) in cases().into_iter().take(24) {
+        for (name, data, format) in cases().into_iter().take(4 * bases().len()) {
             let step = if data.len() > 10_000 { 97 } else { 1 };
             for cut in (0..data.len()).step_by(step) {
                 let chunk = CHUNKS[cut % CHUNKS.len()];
@@ -821,12 +855,16 @@ mod tests {
         }
     }
 
-    /// The seed corpus and the regressions of the PLY and STL fuzz targets.
+    /// The seed corpus and the regressions of the fuzz targets of the streamed readers.
     #[test]
     fn fuzz_inputs_give_what_memory_gives() {
         let fuzz = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz");
         let mut seen = 0;
-        for (target, format) in [("read_ply", Format::Ply), ("read_stl", Format::Stl)] {
+        for (target, format) in [
+            ("read_ply", Format::Ply),
+            ("read_stl", Format::Stl),
+            ("read_off", Format::Off),
+        ] {
             for kind in ["corpus", "regressions"] {
                 let Ok(entries) = std::fs::read_dir(fuzz.join(kind).join(target)) else {
                     continue;

@@ -330,7 +330,7 @@ fn read_plain(
         Format::Obj => obj::read(&input.rest()?, &mut notes)?,
         Format::Ply => ply::read(input, &mut notes)?,
         Format::Stl => stl::read(input, &mut notes)?,
-        Format::Off => off::read(&input.rest()?, &mut notes)?,
+        Format::Off => off::read(input, &mut notes)?,
         Format::Gltf | Format::Glb => gltf::read(&input.rest()?, format, external, &mut notes)?,
     };
     let loaded = LoadedMesh { mesh, notes };
@@ -596,8 +596,27 @@ pub fn write_path_commented(
     })
 }
 
+/// Bytes of the data's start that [`sniff`] looks at (and, past them, only leading
+/// whitespace).
+pub(crate) const SNIFF_HEAD: usize = 4096;
+
 /// What `bytes` look like, for error messages when they are not the claimed format.
 pub(crate) fn sniff(bytes: &[u8]) -> Option<&'static str> {
+    sniff_start(
+        &bytes[..bytes.len().min(SNIFF_HEAD)],
+        starts_solid(text::trim_start(bytes)),
+    )
+}
+
+/// Whether text starts with `solid` (any case), as ASCII STL does.
+pub(crate) fn starts_solid(text: &[u8]) -> bool {
+    text.get(..5)
+        .is_some_and(|w| w.eq_ignore_ascii_case(b"solid"))
+}
+
+/// [`sniff`] from what it needs of the data: its first [`SNIFF_HEAD`] bytes (all of
+/// it when shorter), and whether it starts with `solid` after leading whitespace.
+pub(crate) fn sniff_start(head: &[u8], solid: bool) -> Option<&'static str> {
     const MAGIC: [(&[u8], &str); 7] = [
         (b"\x89PNG", "a PNG image"),
         (b"\xff\xd8\xff", "a JPEG image"),
@@ -607,20 +626,19 @@ pub(crate) fn sniff(bytes: &[u8]) -> Option<&'static str> {
         (b"\x1f\x8b", "gzip data"),
         (b"glTF", "a binary glTF file"),
     ];
-    if let Some((_, what)) = MAGIC.iter().find(|(m, _)| bytes.starts_with(m)) {
+    if let Some((_, what)) = MAGIC.iter().find(|(m, _)| head.starts_with(m)) {
         return Some(what);
     }
-    if bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n") {
+    if head.starts_with(b"ply\n") || head.starts_with(b"ply\r\n") {
         return Some("a PLY file");
     }
-    let head = &bytes[..bytes.len().min(4096)];
+    let head = &head[..head.len().min(SNIFF_HEAD)];
     let first = text::first_content_line(head, b'#');
     let word = first.split(|b| b.is_ascii_whitespace()).next()?;
     if word.len() >= 3 && word.ends_with(b"OFF") && word.iter().all(u8::is_ascii_alphanumeric) {
         return Some("an OFF file");
     }
-    let trimmed = text::trim_start(bytes);
-    if trimmed.len() >= 5 && trimmed[..5].eq_ignore_ascii_case(b"solid") {
+    if solid {
         return Some("an ASCII STL file");
     }
     if head.iter().all(|&b| b >= 0x20 || b.is_ascii_whitespace())

@@ -1,4 +1,8 @@
-//! Byte-level helpers for the text formats: lines, tokens, numbers. No allocation.
+//! Byte-level helpers for the text formats: lines, tokens, numbers; and [`TextStream`],
+//! which reads lines out of an [`Input`] a chunk at a time.
+
+use super::input::Input;
+use super::ReadError;
 
 /// Lines of `data` with their 1-based numbers; `\r\n` and `\n` both end a line.
 pub(crate) fn lines(data: &[u8]) -> impl Iterator<Item = (usize, &[u8])> {
@@ -130,6 +134,111 @@ impl<'a> Tokens<'a> {
     }
 }
 
+/// Lines read out of an [`Input`] as it arrives, so that a text file is parsed without
+/// holding it whole: what was read is consumed a window at a time, and the window's
+/// buffer grows (doubling) only while one line is longer than it, so it holds about
+/// the data's longest line and a chunk, whatever the file's size.
+///
+/// Lines and line numbers are those of [`lines`] over the same bytes: `\r\n` and `\n`
+/// end a line (a `\r\n` split between two reads included), a final line without a
+/// line break is a line, a final line break does not start one.
+pub(crate) struct TextStream<'i, 'a> {
+    input: &'i mut Input<'a>,
+    /// Bytes at the window's start already returned; consumed when the window is
+    /// refilled (consuming per line would cost a call per line for nothing).
+    pos: usize,
+    /// Line number of the byte at `pos`.
+    line: usize,
+    /// Lines that are not UTF-8 among those consumed, when counted (see
+    /// [`TextStream::count_non_utf8`]).
+    non_utf8: Option<usize>,
+}
+
+impl<'i, 'a> TextStream<'i, 'a> {
+    /// Starts at the window's first byte, which is on line `first_line`.
+    pub(crate) fn new(input: &'i mut Input<'a>, first_line: usize) -> Self {
+        Self {
+            input,
+            pos: 0,
+            line: first_line,
+            non_utf8: None,
+        }
+    }
+
+    /// Counts the lines that are not UTF-8 from here on, as [`non_utf8_lines`] counts
+    /// them in the whole text; [`TextStream::non_utf8_lines`] gives the count once the
+    /// lines are read. Only for reading by lines ([`TextStream::next_line_span`]): the count
+    /// is taken over whole lines as they are consumed.
+    pub(crate) fn count_non_utf8(&mut self) {
+        self.non_utf8 = Some(0);
+    }
+
+    /// The lines that are not UTF-8 among those read since
+    /// [`TextStream::count_non_utf8`] (0 when not counted).
+    pub(crate) fn non_utf8_lines(&mut self) -> usize {
+        self.release();
+        self.non_utf8.unwrap_or(0)
+    }
+
+    /// Consumes what was returned, counting its lines that are not UTF-8 if asked.
+    fn release(&mut self) {
+        if let Some(n) = &mut self.non_utf8 {
+            *n += non_utf8_lines(self.input.window().get(..self.pos).unwrap_or_default());
+        }
+        self.input.consume(self.pos);
+        self.pos = 0;
+    }
+
+    /// Consumes what was returned and reads more: the window then holds more bytes
+    /// after the cursor than before, or all that is left.
+    fn refill(&mut self) -> Result<(), ReadError> {
+        self.release();
+        let have = self.input.window().len();
+        self.input.fill(have.saturating_add(1))
+    }
+
+    /// The next line (without its line break and one `\r` before it) as a range of
+    /// [`TextStream::span`], and its number, or `None` at the end of the data.
+    pub(crate) fn next_line_span(
+        &mut self,
+    ) -> Result<Option<(usize, std::ops::Range<usize>)>, ReadError> {
+        let (start, mut end) = loop {
+            let window = self.input.window();
+            let rest = window.get(self.pos..).unwrap_or_default();
+            if let Some(i) = rest.iter().position(|&b| b == b'\n') {
+                let start = self.pos;
+                self.pos += i + 1;
+                break (start, start + i);
+            }
+            if self.input.at_end() {
+                if rest.is_empty() {
+                    return Ok(None);
+                }
+                let start = self.pos;
+                self.pos = window.len();
+                break (start, window.len());
+            }
+            self.refill()?;
+        };
+        if end > start && self.input.window().get(end - 1) == Some(&b'\r') {
+            end -= 1;
+        }
+        let no = self.line;
+        self.line += 1;
+        Ok(Some((no, start..end)))
+    }
+
+    /// The bytes of a span given by the last call to [`TextStream::next_line_span`].
+    pub(crate) fn span(&self, span: std::ops::Range<usize>) -> &[u8] {
+        self.input.window().get(span).unwrap_or_default()
+    }
+
+    /// The most bytes the rest of the data can hold ([`Input::could_hold`]).
+    pub(crate) fn could_hold(&self) -> usize {
+        self.input.could_hold()
+    }
+}
+
 /// Parses a decimal floating-point number (Rust's syntax, which includes `inf` and
 /// `nan`; callers check finiteness).
 pub(crate) fn parse_f64(tok: &[u8]) -> Option<f64> {
@@ -194,6 +303,37 @@ mod tests {
         let v: Vec<_> = lines(b"a\r\nb\n\nc").collect();
         assert_eq!(v, vec![(1, &b"a"[..]), (2, b"b"), (3, b""), (4, b"c")]);
         assert_eq!(lines(b"a\n").count(), 1);
+    }
+
+    /// Every split of lines between reads (a `\r\n` cut in two, a line longer than a
+    /// read, no final line break) gives the lines of [`lines`], and the count of lines
+    /// that are not UTF-8 of [`non_utf8_lines`].
+    #[test]
+    fn streamed_lines_are_the_lines_of_the_whole() {
+        let long = "x".repeat(5000);
+        let texts: [&[u8]; 6] = [
+            b"a\r\nb\n\nc",
+            b"a\r\n\r\n\xe9\r\nlast\r\n",
+            b"\n\n",
+            b"one line, no break",
+            b"\r\r\n\r",
+            long.as_bytes(),
+        ];
+        for text in texts {
+            let text = [text, b"\n", text].concat();
+            for chunk in [1, 2, 3, 7, 4096] {
+                let mut input = Input::reader(Box::new(&text[..]), 0, chunk).expect("memory reads");
+                let mut stream = TextStream::new(&mut input, 1);
+                stream.count_non_utf8();
+                let mut got = Vec::new();
+                while let Some((no, span)) = stream.next_line_span().expect("memory reads") {
+                    got.push((no, stream.span(span).to_vec()));
+                }
+                let want: Vec<_> = lines(&text).map(|(no, l)| (no, l.to_vec())).collect();
+                assert_eq!(got, want, "{text:?} in chunks of {chunk}");
+                assert_eq!(stream.non_utf8_lines(), non_utf8_lines(&text));
+            }
+        }
     }
 
     #[test]
