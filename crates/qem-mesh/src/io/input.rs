@@ -108,15 +108,6 @@ impl<'a> Input<'a> {
         Input::new(Source::Memory(data), true, Some(data.len() as u64), CHUNK)
     }
 
-    /// [`Input::plain`] for data that starts at `offset` of a larger whole (errors give
-    /// places in the whole).
-    pub(crate) fn plain_at(data: &'a [u8], offset: u64) -> Input<'a> {
-        let mut input = Input::plain(data);
-        input.offset = offset;
-        input.expected = Some(offset + data.len() as u64);
-        input
-    }
-
     /// The data of a file, decompressed as it is read when it starts with the gzip
     /// magic.
     pub(crate) fn file(file: std::fs::File) -> std::io::Result<Input<'static>> {
@@ -709,6 +700,27 @@ mod tests {
                 .into_bytes(),
                 Format::Off,
             ),
+            (
+                "ascii ply, bom, crlf, colours, a quad",
+                b"\xEF\xBB\xBFply\r\nformat ascii 1.0\r\ncomment caf\xe9\r\nelement vertex 4\r\n\
+                  property float x\r\nproperty float y\r\nproperty float z\r\n\
+                  property uchar red\r\nproperty uchar green\r\nproperty uchar blue\r\n\
+                  element face 2\r\nproperty list uchar int vertex_indices\r\nend_header\r\n\
+                  0 0 0 255 0 0\r\n1 0 0 0 255 0\r\n1 1 0 0 0 255\r\n0 1 0 9 9 9\r\n\
+                  4 0 1 2 3\r\n3\t0 1\r\n 2"
+                    .to_vec(),
+                Format::Ply,
+            ),
+            (
+                // Cut after "9", the list claims more than the rest holds: that error,
+                // not the index's.
+                "ascii ply, an index out of range",
+                b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+                  property float z\nelement face 1\nproperty list uchar int vertex_indices\n\
+                  end_header\n0 0 0\n1 0 0\n0 1 0\n4 0 1 9 2\n"
+                    .to_vec(),
+                Format::Ply,
+            ),
         ]
     }
 
@@ -832,6 +844,26 @@ mod tests {
         for (name, data, format) in cases() {
             for (k, &chunk) in CHUNKS.iter().enumerate() {
                 check(&data, format, chunk, k % 2 == 0, &name);
+            }
+        }
+    }
+
+    /// An ASCII PLY list's items are read as they arrive: when one fails, the rest of
+    /// the data decides whether the list claimed more items than it can hold (that
+    /// error, as when the whole data was looked at first) or the item's error stands.
+    #[test]
+    fn an_ascii_list_that_claims_too_much_is_found_when_an_item_fails() {
+        let ply = b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n\
+            property float y\nproperty float z\nelement face 1\n\
+            property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n4 0 1 9 2\n";
+        let cut = ply.len() - 3;
+        let claims = "line 13: unexpected end of file in face 0: its list claims 4 items, \
+                      more than the rest of the file can hold";
+        let index = "line 13: face 0 refers to vertex 9, but there are only 3 vertices";
+        for (data, want) in [(&ply[..], index), (&ply[..cut], claims)] {
+            for chunk in CHUNKS {
+                let got = chunked(data, Format::Ply, chunk, true).map(|_| ());
+                assert_eq!(got.map_err(|e| e.to_string()), Err(want.to_string()));
             }
         }
     }

@@ -614,6 +614,26 @@ pub(crate) fn starts_solid(text: &[u8]) -> bool {
         .is_some_and(|w| w.eq_ignore_ascii_case(b"solid"))
 }
 
+/// [`sniff`] of the data `input` has not consumed yet, for an error found at its
+/// start: whitespace past [`SNIFF_HEAD`] bytes is consumed rather than held.
+pub(crate) fn sniff_input(input: &mut Input<'_>) -> Result<Option<&'static str>, ReadError> {
+    input.fill(SNIFF_HEAD + 5)?;
+    let window = input.window();
+    let head = window[..window.len().min(SNIFF_HEAD)].to_vec();
+    loop {
+        let window = input.window();
+        let text = text::trim_start(window);
+        if text.len() >= 5 || input.at_end() {
+            return Ok(sniff_start(&head, starts_solid(text)));
+        }
+        let (len, blank) = (window.len(), text.is_empty());
+        if blank {
+            input.consume(len);
+        }
+        input.fill(if blank { 5 } else { len + 1 })?;
+    }
+}
+
 /// [`sniff`] from what it needs of the data: its first [`SNIFF_HEAD`] bytes (all of
 /// it when shorter), and whether it starts with `solid` after leading whitespace.
 pub(crate) fn sniff_start(head: &[u8], solid: bool) -> Option<&'static str> {

@@ -1,5 +1,5 @@
 //! Byte-level helpers for the text formats: lines, tokens, numbers; and [`TextStream`],
-//! which reads lines out of an [`Input`] a chunk at a time.
+//! which reads lines and tokens out of an [`Input`] a chunk at a time.
 
 use super::input::Input;
 use super::ReadError;
@@ -95,11 +95,6 @@ impl<'a> Tokens<'a> {
         self.line
     }
 
-    /// Bytes not yet consumed.
-    pub(crate) fn remaining(&self) -> usize {
-        self.data.len().saturating_sub(self.pos)
-    }
-
     /// The next token, or `None` at the end.
     pub(crate) fn next_token(&mut self) -> Option<&'a [u8]> {
         while let Some(&b) = self.data.get(self.pos) {
@@ -134,14 +129,15 @@ impl<'a> Tokens<'a> {
     }
 }
 
-/// Lines read out of an [`Input`] as it arrives, so that a text file is parsed without
-/// holding it whole: what was read is consumed a window at a time, and the window's
-/// buffer grows (doubling) only while one line is longer than it, so it holds about
-/// the data's longest line and a chunk, whatever the file's size.
+/// Lines or tokens read out of an [`Input`] as it arrives, so that a text file is
+/// parsed without holding it whole: what was read is consumed a window at a time, and
+/// the window's buffer grows (doubling) only while one line (or token) is longer than
+/// it, so it holds about the data's longest line and a chunk, whatever the file's size.
 ///
 /// Lines and line numbers are those of [`lines`] over the same bytes: `\r\n` and `\n`
 /// end a line (a `\r\n` split between two reads included), a final line without a
-/// line break is a line, a final line break does not start one.
+/// line break is a line, a final line break does not start one. Tokens are separated
+/// by ASCII whitespace, line breaks included.
 pub(crate) struct TextStream<'i, 'a> {
     input: &'i mut Input<'a>,
     /// Bytes at the window's start already returned; consumed when the window is
@@ -231,6 +227,54 @@ impl<'i, 'a> TextStream<'i, 'a> {
     /// The bytes of a span given by the last call to [`TextStream::next_line_span`].
     pub(crate) fn span(&self, span: std::ops::Range<usize>) -> &[u8] {
         self.input.window().get(span).unwrap_or_default()
+    }
+
+    /// Line number of the cursor: of the last token returned, or of the next line.
+    pub(crate) fn line(&self) -> usize {
+        self.line
+    }
+
+    /// The next whitespace-separated token and its line, or `None` at the end of the
+    /// data (the lines passed are counted: see [`TextStream::line`]).
+    pub(crate) fn next_token(&mut self) -> Result<Option<(&[u8], usize)>, ReadError> {
+        let (start, end) = loop {
+            let window = self.input.window();
+            let mut i = self.pos;
+            while let Some(&b) = window.get(i) {
+                if !b.is_ascii_whitespace() {
+                    break;
+                }
+                self.line += usize::from(b == b'\n');
+                i += 1;
+            }
+            let start = i;
+            while let Some(&b) = window.get(i) {
+                if b.is_ascii_whitespace() {
+                    break;
+                }
+                i += 1;
+            }
+            // A token that reaches the window's end may go on in the next read.
+            if i < window.len() || self.input.at_end() {
+                self.pos = i;
+                break (start, i);
+            }
+            self.pos = start;
+            self.refill()?;
+        };
+        Ok((end > start).then(|| (self.span(start..end), self.line)))
+    }
+
+    /// Offset in the data of the cursor.
+    pub(crate) fn offset(&self) -> u64 {
+        self.input.offset() + self.pos as u64
+    }
+
+    /// Reads (and consumes) the rest of the data to count its bytes, from the cursor:
+    /// for an error that depends on the size of the rest.
+    pub(crate) fn count_rest(&mut self) -> Result<u64, ReadError> {
+        self.release();
+        self.input.skip(u64::MAX)
     }
 
     /// The most bytes the rest of the data can hold ([`Input::could_hold`]).
