@@ -721,6 +721,22 @@ mod tests {
                     .to_vec(),
                 Format::Ply,
             ),
+            (
+                "ascii stl, bom, crlf, latin-1 names, a quad facet, an unknown word",
+                b"\xEF\xBB\xBFsolid caf\xe9 part\r\n facet normal 0 0 1\r\n  outer loop\r\n\
+                  \x20  vertex 0 0 0\r\n   vertex 1 0 0\r\n   vertex 1 1 0\r\n   vertex 0 1 0\r\n\
+                  \x20 endloop\r\n endfacet\r\n color 1 2 3\r\nendsolid caf\xe9\r\n"
+                    .to_vec(),
+                Format::Stl,
+            ),
+            (
+                "ascii stl, upper case, no final line break",
+                b"SOLID\nFACET NORMAL 0 0 0\nOUTER LOOP\nVERTEX 0 0 0\nVERTEX 1e0 0 0\n\
+                  VERTEX 0 1 -0\nENDLOOP\nENDFACET\nfacet normal 0 0 0 outer loop vertex 0 0 1 \
+                  vertex 1 0 1 vertex 0 1 1 endloop endfacet\nENDSOLID"
+                    .to_vec(),
+                Format::Stl,
+            ),
         ]
     }
 

@@ -73,62 +73,6 @@ pub(crate) fn words(line: &[u8]) -> impl Iterator<Item = &[u8]> {
         .filter(|w| !w.is_empty())
 }
 
-/// A cursor over whitespace-separated tokens that may span lines, counting lines.
-pub(crate) struct Tokens<'a> {
-    data: &'a [u8],
-    pos: usize,
-    line: usize,
-}
-
-impl<'a> Tokens<'a> {
-    /// Starts at `data[0]`, which is on line `first_line`.
-    pub(crate) fn new(data: &'a [u8], first_line: usize) -> Self {
-        Self {
-            data,
-            pos: 0,
-            line: first_line,
-        }
-    }
-
-    /// The line of the last token returned (or of the cursor when none was).
-    pub(crate) fn line(&self) -> usize {
-        self.line
-    }
-
-    /// The next token, or `None` at the end.
-    pub(crate) fn next_token(&mut self) -> Option<&'a [u8]> {
-        while let Some(&b) = self.data.get(self.pos) {
-            if !b.is_ascii_whitespace() {
-                break;
-            }
-            if b == b'\n' {
-                self.line += 1;
-            }
-            self.pos += 1;
-        }
-        let start = self.pos;
-        while let Some(&b) = self.data.get(self.pos) {
-            if b.is_ascii_whitespace() {
-                break;
-            }
-            self.pos += 1;
-        }
-        (self.pos > start).then(|| &self.data[start..self.pos])
-    }
-
-    /// Skips to the start of the next line.
-    pub(crate) fn skip_line(&mut self) {
-        match self
-            .data
-            .get(self.pos..)
-            .and_then(|r| r.iter().position(|&b| b == b'\n'))
-        {
-            Some(i) => self.pos += i,
-            None => self.pos = self.data.len(),
-        }
-    }
-}
-
 /// Lines or tokens read out of an [`Input`] as it arrives, so that a text file is
 /// parsed without holding it whole: what was read is consumed a window at a time, and
 /// the window's buffer grows (doubling) only while one line (or token) is longer than
@@ -162,27 +106,41 @@ impl<'i, 'a> TextStream<'i, 'a> {
     }
 
     /// Counts the lines that are not UTF-8 from here on, as [`non_utf8_lines`] counts
-    /// them in the whole text; [`TextStream::non_utf8_lines`] gives the count once the
-    /// lines are read. Only for reading by lines ([`TextStream::next_line_span`]): the count
-    /// is taken over whole lines as they are consumed.
+    /// them in the whole text; [`TextStream::non_utf8_lines`] gives the count once all
+    /// the lines are read. A line is counted once all of it has been passed, so the
+    /// window then keeps the line of the cursor whole.
     pub(crate) fn count_non_utf8(&mut self) {
         self.non_utf8 = Some(0);
     }
 
     /// The lines that are not UTF-8 among those read since
-    /// [`TextStream::count_non_utf8`] (0 when not counted).
+    /// [`TextStream::count_non_utf8`] (0 when not counted), once all are read: the
+    /// last line counts even without a line break.
     pub(crate) fn non_utf8_lines(&mut self) -> usize {
         self.release();
-        self.non_utf8.unwrap_or(0)
-    }
-
-    /// Consumes what was returned, counting its lines that are not UTF-8 if asked.
-    fn release(&mut self) {
-        if let Some(n) = &mut self.non_utf8 {
-            *n += non_utf8_lines(self.input.window().get(..self.pos).unwrap_or_default());
-        }
+        let Some(n) = &mut self.non_utf8 else {
+            return 0;
+        };
+        *n += non_utf8_lines(self.input.window().get(..self.pos).unwrap_or_default());
         self.input.consume(self.pos);
         self.pos = 0;
+        *n
+    }
+
+    /// Consumes what was returned (when lines are counted, up to the start of the
+    /// cursor's line, counting the lines that are not UTF-8).
+    fn release(&mut self) {
+        let mut done = self.pos;
+        if let Some(n) = &mut self.non_utf8 {
+            let passed = self.input.window().get(..self.pos).unwrap_or_default();
+            done = passed
+                .iter()
+                .rposition(|&b| b == b'\n')
+                .map_or(0, |i| i + 1);
+            *n += non_utf8_lines(&passed[..done]);
+        }
+        self.input.consume(done);
+        self.pos -= done;
     }
 
     /// Consumes what was returned and reads more: the window then holds more bytes
@@ -263,6 +221,24 @@ impl<'i, 'a> TextStream<'i, 'a> {
             self.refill()?;
         };
         Ok((end > start).then(|| (self.span(start..end), self.line)))
+    }
+
+    /// Skips to the end of the line (its line break is the next byte read), holding
+    /// no more of a long line than a window.
+    pub(crate) fn skip_line(&mut self) -> Result<(), ReadError> {
+        loop {
+            let window = self.input.window();
+            let rest = window.get(self.pos..).unwrap_or_default();
+            if let Some(i) = rest.iter().position(|&b| b == b'\n') {
+                self.pos += i;
+                return Ok(());
+            }
+            self.pos = window.len();
+            if self.input.at_end() {
+                return Ok(());
+            }
+            self.refill()?;
+        }
     }
 
     /// Offset in the data of the cursor.
@@ -389,14 +365,36 @@ mod tests {
         assert_eq!(parse_i64(b"1x"), None);
     }
 
+    /// Tokens and their lines, whatever the reads cut: a token split between reads,
+    /// a line break in a run of whitespace, a long token, no final line break;
+    /// `skip_line` stops before the line break, which is then counted.
     #[test]
-    fn tokens_count_lines() {
-        let mut t = Tokens::new(b" a\n\n b c\n", 1);
-        assert_eq!(t.next_token(), Some(&b"a"[..]));
-        assert_eq!(t.line(), 1);
-        assert_eq!(t.next_token(), Some(&b"b"[..]));
-        assert_eq!(t.line(), 3);
-        assert_eq!(t.next_token(), Some(&b"c"[..]));
-        assert_eq!(t.next_token(), None);
+    fn streamed_tokens_count_lines() {
+        let long = "y".repeat(300);
+        let text = format!(" a\r\n\n\t bc  d\nsolid name \u{e9} x\n{long}\n\n e");
+        for chunk in [1, 2, 3, 7, 4096] {
+            let data = text.as_bytes();
+            let mut input = Input::reader(Box::new(data), 0, chunk).expect("memory reads");
+            let mut stream = TextStream::new(&mut input, 1);
+            let mut got = Vec::new();
+            while let Some((token, line)) = stream.next_token().expect("memory reads") {
+                let token = String::from_utf8_lossy(token).into_owned();
+                if token == "solid" {
+                    stream.skip_line().expect("memory reads");
+                }
+                got.push((token, line));
+            }
+            let want = [
+                ("a", 1),
+                ("bc", 3),
+                ("d", 3),
+                ("solid", 4),
+                (&long[..], 5),
+                ("e", 7),
+            ];
+            let want: Vec<_> = want.iter().map(|&(t, l)| (t.to_string(), l)).collect();
+            assert_eq!(got, want, "chunks of {chunk}");
+            assert_eq!(stream.line(), 7);
+        }
     }
 }
