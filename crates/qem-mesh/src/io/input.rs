@@ -4,8 +4,9 @@
 //! so many ([`Input::fill`]), parses whole records out of the window, and consumes them
 //! ([`Input::consume`]); the window is refilled from the source a chunk at a time, so a
 //! binary PLY or STL file is read without holding the file, or its decompressed bytes,
-//! in memory. Data in memory is its own window (nothing is copied), and a reader that
-//! needs all of its data at once (the text formats, glTF) takes the rest with
+//! in memory. The text formats read whole lines or tokens out of the window the same way
+//! ([`super::text::TextStream`]). Data in memory is its own window (nothing is copied),
+//! and a reader that needs all of its data at once (OBJ, glTF) takes the rest with
 //! [`Input::rest`].
 //!
 //! Gzip data is decompressed as it is read, with the caps of [`GZIP_MAX_RATIO`] and
@@ -192,6 +193,7 @@ impl<'a> Input<'a> {
     }
 
     /// The bytes read and not yet consumed.
+    #[inline]
     pub(crate) fn window(&self) -> &[u8] {
         match &self.source {
             Source::Memory(rest) => rest,
@@ -205,6 +207,7 @@ impl<'a> Input<'a> {
     }
 
     /// Whether the window holds all the data that is left.
+    #[inline]
     pub(crate) fn at_end(&self) -> bool {
         self.eof
     }

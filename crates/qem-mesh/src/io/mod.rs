@@ -9,14 +9,16 @@
 //! function from arbitrary bytes to a mesh or an error: it never panics and never
 //! allocates more than the input can justify.
 //!
-//! **Streaming.** Binary PLY and binary STL are read as they arrive, a chunk at a time
-//! (1 MiB), whole records out of each: reading a file takes about the memory of the
-//! arrays it gives, not the file's (or its decompressed data's) size on top (figures in
-//! BENCHMARKS.md, "Loading"). ASCII PLY and STL, OBJ, OFF and glTF are parsed from all
+//! **Streaming.** PLY (binary and ASCII), STL (binary and ASCII) and OFF are read as
+//! they arrive, a chunk at a time (1 MiB): binary records whole, text a line or a token
+//! at a time, so reading a file takes about the memory of the arrays it gives, not the
+//! file's (or its decompressed data's) size on top (a 4M-triangle sphere: 1.04 times
+//! the arrays as OFF or ASCII PLY, 1.01 as ASCII STL, where it was 2.7 and 3.1 times;
+//! figures in BENCHMARKS.md, "Loading"). OBJ and glTF are parsed from all
 //! their (decompressed) bytes at once. Whatever the form, the result and the errors are
 //! those of reading the whole data at once: an error that depends on what comes later
-//! (a cut element, a binary STL's size, a corrupt gzip stream) is given once the rest
-//! has been read.
+//! (a cut element, a binary STL's size, an ASCII PLY list longer than the rest of the
+//! file, a corrupt gzip stream) is given once the rest has been read.
 //!
 //! Polygons are fan-triangulated from their first corner. Vertices are never welded
 //! or removed by the PLY, STL and OFF readers (an STL facet gives three new vertices);
@@ -42,8 +44,9 @@
 //! beyond what the remaining bytes could hold (for gzip data, whose size is known only
 //! at its end, beyond what has arrived: the arrays grow as the data arrives); gzip
 //! output is capped at [`GZIP_MAX_RATIO`] times the compressed size and at
-//! [`GZIP_MAX_BYTES`]. A streamed binary PLY record is held whole before it is read, so
-//! a list that claims more than the file holds costs at most the rest of the file.
+//! [`GZIP_MAX_BYTES`]. A streamed binary PLY record, and a text line (or token), is
+//! held whole before it is read, so a list or a line that claims more than the file
+//! holds costs at most the rest of the file.
 //!
 //! # Writing
 //! [`write_to`] writes any format to a `Write`; [`write_path`] writes a file
@@ -107,7 +110,7 @@ pub const SUPPORTED_EXTENSIONS: &str =
 /// Decompressed gzip data may be at most this many times the compressed size (plus
 /// 64 KiB, so tiny files are never refused).
 ///
-/// Why 64: the text formats hold the whole decompressed file in memory, and deflate can
+/// Why 64: OBJ and glTF hold the whole decompressed file in memory, and deflate can
 /// expand up to about 1032:1, so a 1 MB "zip bomb" of whitespace would otherwise need
 /// over 2 GB (measured: 2.0 GB peak RSS, see FUZZING.md). Real meshes compress far less: gzip -9
 /// of the project's 49-mesh corpus gives at most 9:1 (OBJ text); 64 leaves a margin of
@@ -324,8 +327,8 @@ fn read_plain(
     if format != Format::Stl {
         notes.byte_order_mark = input.skip_bom()?;
     }
-    // Binary PLY and STL are read as they arrive; the other formats, and ASCII PLY and
-    // STL, are parsed from all their bytes at once.
+    // PLY, STL and OFF are read as they arrive; OBJ (whose reader, tobj, is given the
+    // checked text) and glTF (JSON, and buffers anywhere in it) from all their bytes.
     let mesh = match format {
         Format::Obj => obj::read(&input.rest()?, &mut notes)?,
         Format::Ply => ply::read(input, &mut notes)?,

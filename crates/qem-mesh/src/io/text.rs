@@ -153,6 +153,7 @@ impl<'i, 'a> TextStream<'i, 'a> {
 
     /// The next line (without its line break and one `\r` before it) as a range of
     /// [`TextStream::span`], and its number, or `None` at the end of the data.
+    #[inline]
     pub(crate) fn next_line_span(
         &mut self,
     ) -> Result<Option<(usize, std::ops::Range<usize>)>, ReadError> {
@@ -183,6 +184,7 @@ impl<'i, 'a> TextStream<'i, 'a> {
     }
 
     /// The bytes of a span given by the last call to [`TextStream::next_line_span`].
+    #[inline]
     pub(crate) fn span(&self, span: std::ops::Range<usize>) -> &[u8] {
         self.input.window().get(span).unwrap_or_default()
     }
@@ -194,6 +196,7 @@ impl<'i, 'a> TextStream<'i, 'a> {
 
     /// The next whitespace-separated token and its line, or `None` at the end of the
     /// data (the lines passed are counted: see [`TextStream::line`]).
+    #[inline]
     pub(crate) fn next_token(&mut self) -> Result<Option<(&[u8], usize)>, ReadError> {
         let (start, end) = loop {
             let window = self.input.window();
