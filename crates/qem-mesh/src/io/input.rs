@@ -887,6 +887,30 @@ mod tests {
         }
     }
 
+    /// A text line longer than a chunk is held whole, and only it: the window's buffer
+    /// grows by doubling to about the line and a read, not to the file's size (here
+    /// 2.5 MB, of lines gzip cannot shrink past its cap).
+    #[test]
+    fn a_long_line_costs_the_line_not_the_file() {
+        let line = 300_000;
+        let data = format!(
+            "OFF\n# {}\n3 1\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n{}",
+            "x".repeat(line),
+            (0..200_000)
+                .map(|i| format!("after {i}\n"))
+                .collect::<String>()
+        );
+        for data in [data.as_bytes().to_vec(), gzip(data.as_bytes())] {
+            let mut input =
+                Input::reader(Box::new(&data[..]), data.len() as u64, 4096).expect("memory reads");
+            let loaded = read_input(&mut input, Format::Off, None).expect("a valid OFF");
+            assert_eq!(loaded.mesh.triangles, vec![[0, 1, 2]]);
+            assert_eq!(loaded.notes.skipped_lines, 200_000);
+            assert!(input.buf.len() > line, "the line is held whole");
+            assert!(input.buf.len() <= 2 * (line + 4096), "{}", input.buf.len());
+        }
+    }
+
     /// Every truncation of every input, plain and gzipped, each with one of the chunk
     /// sizes in turn.
     #[test]
