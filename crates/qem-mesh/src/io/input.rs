@@ -4,8 +4,8 @@
 //! so many ([`Input::fill`]), parses whole records out of the window, and consumes them
 //! ([`Input::consume`]); the window is refilled from the source a chunk at a time, so a
 //! binary PLY or STL file is read without holding the file, or its decompressed bytes,
-//! in memory. The text formats read whole lines or tokens out of the window the same way
-//! ([`super::text::TextStream`]). Data in memory is its own window (nothing is copied),
+//! in memory. OFF, ASCII PLY and ASCII STL read whole lines or tokens out of the window
+//! the same way ([`super::text::TextStream`]). Data in memory is its own window (nothing is copied),
 //! and a reader that needs all of its data at once (OBJ, glTF) takes the rest with
 //! [`Input::rest`].
 //!
