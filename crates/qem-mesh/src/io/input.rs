@@ -512,6 +512,78 @@ mod tests {
         }
     }
 
+    /// `data` read every way a caller can, plain and gzipped: from memory
+    /// (`read_bytes`), from a file (`read_path`) and from a reader in chunks of each
+    /// size of [`CHUNKS`], with the size exact or only an upper bound; each result
+    /// named, an error as its message.
+    fn every_way(data: &[u8], format: Format) -> Vec<(String, Result<LoadedMesh, String>)> {
+        let dir = tempfile::tempdir().expect("a temporary directory");
+        let ext = match format {
+            Format::Off => "off",
+            Format::Ply => "ply",
+            Format::Stl => "stl",
+            _ => unreachable!("the streamed formats"),
+        };
+        let mut got = Vec::new();
+        for (kind, data) in [("plain", data.to_vec()), ("gzipped", gzip(data))] {
+            got.push((
+                format!("{kind} read_bytes"),
+                read_bytes(&data, format).map_err(|e| e.to_string()),
+            ));
+            let path = dir.path().join(format!("{kind}.{ext}"));
+            std::fs::write(&path, &data).expect("a temporary file");
+            let read = crate::io::read_path(&path).map_err(|e| match e {
+                crate::io::IoError::Read { source, .. } => source.to_string(),
+                other => other.to_string(),
+            });
+            got.push((format!("{kind} read_path"), read));
+            for chunk in CHUNKS {
+                for sized in [true, false] {
+                    got.push((
+                        format!("{kind} in chunks of {chunk}, sized {sized}"),
+                        chunked(&data, format, chunk, sized).map_err(|e| e.to_string()),
+                    ));
+                }
+            }
+        }
+        got
+    }
+
+    /// ASCII STL whose last line is not UTF-8 and has no line break: that line is
+    /// counted in `non_utf8_lines`, with and without a byte order mark, as the readers
+    /// that parsed all the bytes at once counted it (values from 69c3ccb).
+    #[test]
+    fn an_ascii_stl_last_line_without_a_line_break_is_counted() {
+        let facet = b"facet normal 0 0 1\n outer loop\n  vertex 0 0 0\n  vertex 1 0 0\n  \
+                      vertex 0 1 0\n endloop\nendfacet\n";
+        let facets = facet.repeat(3);
+        let named = [&b"solid caf\xe9\n"[..], &facets, b"endsolid caf\xe9"].concat();
+        let junk = [&b"solid x\n"[..], &facets, b"endsolid x\n\xff\xfe junk"].concat();
+        for (data, non_utf8, skipped) in [(named, 2, 0), (junk, 1, 1)] {
+            for bom in [false, true] {
+                let data = if bom {
+                    [BOM, &data].concat()
+                } else {
+                    data.clone()
+                };
+                for (how, got) in every_way(&data, Format::Stl) {
+                    let got = got.unwrap_or_else(|e| panic!("{how}: {e}"));
+                    assert_eq!(got.mesh.triangles.len(), 3, "{how}");
+                    let notes = &got.notes;
+                    assert_eq!(
+                        (
+                            notes.non_utf8_lines,
+                            notes.skipped_lines,
+                            notes.byte_order_mark
+                        ),
+                        (non_utf8, skipped, bom),
+                        "{how}, bom {bom}"
+                    );
+                }
+            }
+        }
+    }
+
     fn gzip(data: &[u8]) -> Vec<u8> {
         let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
         enc.write_all(data).expect("memory writes");

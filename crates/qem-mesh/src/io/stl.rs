@@ -57,12 +57,15 @@ pub(crate) fn read(input: &mut Input<'_>, notes: &mut ReadNotes) -> Result<Index
             let mut tok = TextStream::new(input, 1);
             tok.count_non_utf8();
             let read = read_ascii(&mut tok, notes);
+            // Counted before `count_rest`, which consumes the cursor's line: a last
+            // line without a line break would go uncounted.
+            let non_utf8 = tok.non_utf8_lines();
             let len = tok.offset() + tok.count_rest()? + if bom { BOM_LEN as u64 } else { 0 };
             if len == expected_len(n) {
                 return Err(too_many_binary(n));
             }
             let mesh = read?;
-            notes.non_utf8_lines += tok.non_utf8_lines();
+            notes.non_utf8_lines += non_utf8;
             Ok(mesh)
         }
         _ => read_all(&input.rest()?, notes),
