@@ -52,7 +52,13 @@ pub(crate) fn read(input: &mut Input<'_>, notes: &mut ReadNotes) -> Result<Index
             if ascii
                 && (n as usize > MAX_ELEMENTS || expected_len(n) > input.could_hold() as u64) =>
         {
+            // Only a count beyond `MAX_ELEMENTS` can leave the size in doubt here: the
+            // rest is read to its end for that one case, not for every error.
+            let maybe_binary =
+                n as usize > MAX_ELEMENTS && expected_len(n) <= input.could_hold() as u64;
             notes.byte_order_mark = bom;
+            // Unlike `skip_bom`, offsets keep counting the mark: the size compared is
+            // the whole data's.
             input.consume(if bom { BOM_LEN } else { 0 });
             let mut tok = TextStream::new(input, 1);
             tok.count_non_utf8();
@@ -60,8 +66,7 @@ pub(crate) fn read(input: &mut Input<'_>, notes: &mut ReadNotes) -> Result<Index
             // Counted before `count_rest`, which consumes the cursor's line: a last
             // line without a line break would go uncounted.
             let non_utf8 = tok.non_utf8_lines();
-            let len = tok.offset() + tok.count_rest()? + if bom { BOM_LEN as u64 } else { 0 };
-            if len == expected_len(n) {
+            if maybe_binary && tok.offset() + tok.count_rest()? == expected_len(n) {
                 return Err(too_many_binary(n));
             }
             let mesh = read?;

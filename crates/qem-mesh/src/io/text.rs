@@ -249,11 +249,15 @@ impl<'i, 'a> TextStream<'i, 'a> {
         self.input.offset() + self.pos as u64
     }
 
-    /// Reads (and consumes) the rest of the data to count its bytes, from the cursor:
-    /// for an error that depends on the size of the rest.
+    /// Reads (and consumes) the rest of the data to count its bytes from the cursor:
+    /// for an error that depends on the size of the rest. Lines not counted yet are
+    /// left uncounted ([`TextStream::non_utf8_lines`] comes first).
     pub(crate) fn count_rest(&mut self) -> Result<u64, ReadError> {
+        let from = self.offset();
         self.release();
-        self.input.skip(u64::MAX)
+        // `release` may keep the cursor's line in the window: count from the window's
+        // start, then take off what lies before the cursor.
+        Ok(self.input.offset() + self.input.skip(u64::MAX)? - from)
     }
 
     /// The most bytes the rest of the data can hold ([`Input::could_hold`]).
@@ -355,6 +359,38 @@ mod tests {
                 let want: Vec<_> = lines(&text).map(|(no, l)| (no, l.to_vec())).collect();
                 assert_eq!(got, want, "{text:?} in chunks of {chunk}");
                 assert_eq!(stream.non_utf8_lines(), non_utf8_lines(&text));
+            }
+        }
+    }
+
+    /// `count_rest` gives the bytes from the cursor to the end, whether lines are
+    /// counted (which keeps the cursor's line in the window) or not, and after a byte
+    /// order mark consumed as the STL reader consumes it (offsets then count it).
+    #[test]
+    fn count_rest_counts_from_the_cursor() {
+        let text = b"solid a\nendsolid a";
+        for bom in [false, true] {
+            let data = if bom {
+                [super::super::BOM, &text[..]].concat()
+            } else {
+                text.to_vec()
+            };
+            for count in [false, true] {
+                for chunk in [1, 3, 4096] {
+                    let mut input =
+                        Input::reader(Box::new(&data[..]), 0, chunk).expect("memory reads");
+                    input.fill(3).expect("memory reads");
+                    input.consume(if bom { 3 } else { 0 });
+                    let mut stream = TextStream::new(&mut input, 1);
+                    if count {
+                        stream.count_non_utf8();
+                    }
+                    stream.next_token().expect("memory reads");
+                    let at = stream.offset();
+                    assert_eq!(at, if bom { 8 } else { 5 });
+                    let rest = stream.count_rest().expect("memory reads");
+                    assert_eq!(at + rest, data.len() as u64, "bom {bom}, count {count}");
+                }
             }
         }
     }
