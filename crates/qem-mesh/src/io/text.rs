@@ -21,15 +21,98 @@ pub(crate) fn lines(data: &[u8]) -> impl Iterator<Item = (usize, &[u8])> {
     })
 }
 
-/// How many lines of `data` are not valid UTF-8 (one check of the whole text first:
-/// nearly every file is, and that is much cheaper than a check per line).
+/// How many lines of `data` are not valid UTF-8.
 pub(crate) fn non_utf8_lines(data: &[u8]) -> usize {
-    if std::str::from_utf8(data).is_ok() {
-        return 0;
+    let mut count = Utf8Lines::default();
+    count.pass(data);
+    count.total()
+}
+
+/// Counts the lines that are not valid UTF-8 in text given in pieces, cut anywhere
+/// (in a line, in a character): what is kept between pieces is whether the line being
+/// passed is already known bad, and the bytes of a character cut at a piece's end.
+#[derive(Default)]
+struct Utf8Lines {
+    /// Lines passed whole (up to their line break) that are not UTF-8.
+    bad_lines: usize,
+    /// The line being passed holds bytes that are not UTF-8.
+    bad: bool,
+    /// The start of a character cut at the last piece's end (at most 3 bytes).
+    pending: [u8; 3],
+    pending_len: usize,
+}
+
+impl Utf8Lines {
+    /// Passes the next bytes of the text. Each byte is looked at a bounded number of
+    /// times: valid text is checked in one run up to its first error (nearly every
+    /// file is UTF-8, and one check of a run is much cheaper than one per line), a bad
+    /// line is only searched for its end.
+    fn pass(&mut self, mut bytes: &[u8]) {
+        while !bytes.is_empty() {
+            if self.bad {
+                let Some(i) = bytes.iter().position(|&b| b == b'\n') else {
+                    return;
+                };
+                self.bad_lines += 1;
+                self.bad = false;
+                bytes = &bytes[i + 1..];
+            } else if self.pending_len > 0 {
+                // Completes the cut character with the bytes it still needs (a
+                // character is at most 4 bytes).
+                let p = self.pending_len;
+                let k = bytes.len().min(4 - p);
+                let mut joined = [0u8; 4];
+                joined[..p].copy_from_slice(&self.pending[..p]);
+                joined[p..p + k].copy_from_slice(&bytes[..k]);
+                match std::str::from_utf8(&joined[..p + k]) {
+                    Ok(_) => {
+                        self.pending_len = 0;
+                        bytes = &bytes[k..];
+                    }
+                    // The first character is whole (and longer than the cut part).
+                    Err(e) if e.valid_up_to() > 0 => {
+                        self.pending_len = 0;
+                        bytes = &bytes[e.valid_up_to() - p..];
+                    }
+                    // Not UTF-8: `bytes` may end the line, so they are searched.
+                    Err(e) if e.error_len().is_some() => {
+                        self.pending_len = 0;
+                        self.bad = true;
+                    }
+                    // Still cut: all of `bytes` (fewer than it needs) is kept.
+                    Err(_) => {
+                        self.pending[..p + k].copy_from_slice(&joined[..p + k]);
+                        self.pending_len = p + k;
+                        return;
+                    }
+                }
+            } else {
+                match std::str::from_utf8(bytes) {
+                    Ok(_) => return,
+                    Err(e) => {
+                        let valid = e.valid_up_to();
+                        if e.error_len().is_some() {
+                            self.bad = true;
+                            bytes = &bytes[valid..];
+                        } else {
+                            // A character cut at the end (a line break would have made
+                            // it an error): at most 3 bytes.
+                            let cut = &bytes[valid..];
+                            self.pending[..cut.len()].copy_from_slice(cut);
+                            self.pending_len = cut.len();
+                            return;
+                        }
+                    }
+                }
+            }
+        }
     }
-    lines(data)
-        .filter(|(_, l)| std::str::from_utf8(l).is_err())
-        .count()
+
+    /// The lines that are not UTF-8, the last one included when the text ends without
+    /// a line break.
+    fn total(&self) -> usize {
+        self.bad_lines + usize::from(self.bad || self.pending_len > 0)
+    }
 }
 
 /// `s` without leading ASCII whitespace.
@@ -74,9 +157,9 @@ pub(crate) fn words(line: &[u8]) -> impl Iterator<Item = &[u8]> {
 }
 
 /// Lines or tokens read out of an [`Input`] as it arrives, so that a text file is
-/// parsed without holding it whole: what was read is consumed a window at a time, and
-/// the window's buffer grows (doubling) only while one line (or token) is longer than
-/// it, so it holds about the data's longest line and a chunk, whatever the file's size.
+/// parsed without holding it whole: what was read is consumed at each refill, and the
+/// window holds about the line (or token) being read and a read, whatever the file's
+/// size ([`Input`] grows its buffer only while one is longer than it).
 ///
 /// Lines and line numbers are those of [`lines`] over the same bytes: `\r\n` and `\n`
 /// end a line (a `\r\n` split between two reads included), a final line without a
@@ -89,9 +172,9 @@ pub(crate) struct TextStream<'i, 'a> {
     pos: usize,
     /// Line number of the byte at `pos`.
     line: usize,
-    /// Lines that are not UTF-8 among those consumed, when counted (see
+    /// The lines that are not UTF-8 among those consumed, when counted (see
     /// [`TextStream::count_non_utf8`]).
-    non_utf8: Option<usize>,
+    non_utf8: Option<Utf8Lines>,
 }
 
 impl<'i, 'a> TextStream<'i, 'a> {
@@ -107,10 +190,9 @@ impl<'i, 'a> TextStream<'i, 'a> {
 
     /// Counts the lines that are not UTF-8 from here on, as [`non_utf8_lines`] counts
     /// them in the whole text; [`TextStream::non_utf8_lines`] gives the count once all
-    /// the lines are read. A line is counted once all of it has been passed, so the
-    /// window then keeps the line of the cursor whole.
+    /// the lines are read.
     pub(crate) fn count_non_utf8(&mut self) {
-        self.non_utf8 = Some(0);
+        self.non_utf8 = Some(Utf8Lines::default());
     }
 
     /// The lines that are not UTF-8 among those read since
@@ -118,29 +200,17 @@ impl<'i, 'a> TextStream<'i, 'a> {
     /// last line counts even without a line break.
     pub(crate) fn non_utf8_lines(&mut self) -> usize {
         self.release();
-        let Some(n) = &mut self.non_utf8 else {
-            return 0;
-        };
-        *n += non_utf8_lines(self.input.window().get(..self.pos).unwrap_or_default());
-        self.input.consume(self.pos);
-        self.pos = 0;
-        *n
+        self.non_utf8.as_ref().map_or(0, Utf8Lines::total)
     }
 
-    /// Consumes what was returned (when lines are counted, up to the start of the
-    /// cursor's line, counting the lines that are not UTF-8).
+    /// Consumes what was returned (counting its lines that are not UTF-8, when
+    /// counted).
     fn release(&mut self) {
-        let mut done = self.pos;
-        if let Some(n) = &mut self.non_utf8 {
-            let passed = self.input.window().get(..self.pos).unwrap_or_default();
-            done = passed
-                .iter()
-                .rposition(|&b| b == b'\n')
-                .map_or(0, |i| i + 1);
-            *n += non_utf8_lines(&passed[..done]);
+        if let Some(count) = &mut self.non_utf8 {
+            count.pass(self.input.window().get(..self.pos).unwrap_or_default());
         }
-        self.input.consume(done);
-        self.pos -= done;
+        self.input.consume(self.pos);
+        self.pos = 0;
     }
 
     /// Consumes what was returned and reads more: the window then holds more bytes
@@ -157,22 +227,27 @@ impl<'i, 'a> TextStream<'i, 'a> {
     pub(crate) fn next_line_span(
         &mut self,
     ) -> Result<Option<(usize, std::ops::Range<usize>)>, ReadError> {
+        // Bytes after the cursor already searched: a line longer than a read is
+        // searched once, not again from its start after each read.
+        let mut searched = 0;
         let (start, mut end) = loop {
             let window = self.input.window();
-            let rest = window.get(self.pos..).unwrap_or_default();
+            let rest = window.get(self.pos + searched..).unwrap_or_default();
             if let Some(i) = rest.iter().position(|&b| b == b'\n') {
                 let start = self.pos;
-                self.pos += i + 1;
-                break (start, start + i);
+                let end = start + searched + i;
+                self.pos = end + 1;
+                break (start, end);
             }
             if self.input.at_end() {
-                if rest.is_empty() {
+                if self.pos == window.len() {
                     return Ok(None);
                 }
                 let start = self.pos;
                 self.pos = window.len();
                 break (start, window.len());
             }
+            searched = window.len() - self.pos;
             self.refill()?;
         };
         if end > start && self.input.window().get(end - 1) == Some(&b'\r') {
@@ -198,17 +273,22 @@ impl<'i, 'a> TextStream<'i, 'a> {
     /// data (the lines passed are counted: see [`TextStream::line`]).
     #[inline]
     pub(crate) fn next_token(&mut self) -> Result<Option<(&[u8], usize)>, ReadError> {
+        // Bytes of the token already searched (after the cursor, which is at its
+        // start): a token longer than a read is searched once.
+        let mut searched = 0;
         let (start, end) = loop {
             let window = self.input.window();
-            let mut i = self.pos;
-            while let Some(&b) = window.get(i) {
-                if !b.is_ascii_whitespace() {
-                    break;
+            if searched == 0 {
+                while let Some(&b) = window.get(self.pos) {
+                    if !b.is_ascii_whitespace() {
+                        break;
+                    }
+                    self.line += usize::from(b == b'\n');
+                    self.pos += 1;
                 }
-                self.line += usize::from(b == b'\n');
-                i += 1;
             }
-            let start = i;
+            let start = self.pos;
+            let mut i = start + searched;
             while let Some(&b) = window.get(i) {
                 if b.is_ascii_whitespace() {
                     break;
@@ -220,14 +300,14 @@ impl<'i, 'a> TextStream<'i, 'a> {
                 self.pos = i;
                 break (start, i);
             }
-            self.pos = start;
+            searched = i - start;
             self.refill()?;
         };
         Ok((end > start).then(|| (self.span(start..end), self.line)))
     }
 
-    /// Skips to the end of the line (its line break is the next byte read), holding
-    /// no more of a long line than a window.
+    /// Skips to the end of the line (its line break is the next byte read); what is
+    /// skipped is consumed as it is read.
     pub(crate) fn skip_line(&mut self) -> Result<(), ReadError> {
         loop {
             let window = self.input.window();
@@ -253,11 +333,8 @@ impl<'i, 'a> TextStream<'i, 'a> {
     /// for an error that depends on the size of the rest. Lines not counted yet are
     /// left uncounted ([`TextStream::non_utf8_lines`] comes first).
     pub(crate) fn count_rest(&mut self) -> Result<u64, ReadError> {
-        let from = self.offset();
         self.release();
-        // `release` may keep the cursor's line in the window: count from the window's
-        // start, then take off what lies before the cursor.
-        Ok(self.input.offset() + self.input.skip(u64::MAX)? - from)
+        self.input.skip(u64::MAX)
     }
 
     /// The most bytes the rest of the data can hold ([`Input::could_hold`]).
@@ -363,6 +440,37 @@ mod tests {
         }
     }
 
+    /// Lines that are not UTF-8 counted in pieces cut anywhere (in a character, at a
+    /// line break) as a check of each whole line counts them.
+    #[test]
+    fn non_utf8_lines_counted_in_pieces() {
+        let texts: [&[u8]; 8] = [
+            "caf\u{e9}\nna\u{ef}ve \u{1F600}\n\u{20AC}".as_bytes(),
+            b"caf\xe9\nok\n\xe9",
+            b"\xe2\x82\n\xe2\x82\xac\n\xf0\x9f\x98",
+            b"\xff\xfe junk\r\n\r\nfine\n",
+            b"\xc3",
+            b"\xe2\x82\xac\xe2",
+            b"a\n\n\xc3\xa9\xc3\n",
+            b"\xed\xa0\x80\n\xf4\x90\x80\x80\n",
+        ];
+        for text in texts {
+            let want = lines(text)
+                .filter(|(_, l)| std::str::from_utf8(l).is_err())
+                .count();
+            assert_eq!(non_utf8_lines(text), want, "{text:?}");
+            for a in 0..=text.len() {
+                for b in a..=text.len() {
+                    let mut count = Utf8Lines::default();
+                    for piece in [&text[..a], &text[a..b], &text[b..]] {
+                        count.pass(piece);
+                    }
+                    assert_eq!(count.total(), want, "{text:?} cut at {a} and {b}");
+                }
+            }
+        }
+    }
+
     /// `count_rest` gives the bytes from the cursor to the end, whether lines are
     /// counted (which keeps the cursor's line in the window) or not, and after a byte
     /// order mark consumed as the STL reader consumes it (offsets then count it).
@@ -392,6 +500,46 @@ mod tests {
                     assert_eq!(at + rest, data.len() as u64, "bom {bom}, count {count}");
                 }
             }
+        }
+    }
+
+    /// A line (or token) much longer than a read costs time in proportion to its
+    /// length: the search for its end resumes where the last read left it, and the
+    /// lines that are not UTF-8 are counted as the bytes pass. Before, each read
+    /// searched the line again from its start: here 2^14 reads of a 1 MiB line, some
+    /// 8 GiB of bytes looked at (tens of seconds in a debug build; now well under one).
+    #[test]
+    fn a_long_line_read_in_small_pieces_costs_its_length() {
+        let long = "x".repeat(1 << 20);
+        let crs = "\r".repeat(1 << 20);
+        let cases = [
+            format!("a\n{long}\nb\n"),
+            format!("a\n{crs}\nb"),
+            format!("a {long} b"),
+        ];
+        for text in &cases {
+            let began = std::time::Instant::now();
+            for lines in [true, false] {
+                let mut input =
+                    Input::reader(Box::new(text.as_bytes()), 0, 64).expect("memory reads");
+                let mut stream = TextStream::new(&mut input, 1);
+                stream.count_non_utf8();
+                let mut longest = 0;
+                if lines {
+                    while let Some((_, span)) = stream.next_line_span().expect("memory reads") {
+                        longest = longest.max(span.len());
+                    }
+                } else {
+                    while let Some((t, _)) = stream.next_token().expect("memory reads") {
+                        longest = longest.max(t.len());
+                    }
+                }
+                let short = !lines && !text.contains('x');
+                assert!(longest >= (1 << 20) - 1 || short, "{longest}");
+                assert_eq!(stream.non_utf8_lines(), 0);
+            }
+            let took = began.elapsed();
+            assert!(took.as_secs_f64() < 5.0, "{took:?}");
         }
     }
 
