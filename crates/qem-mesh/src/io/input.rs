@@ -357,17 +357,37 @@ impl<'a> Input<'a> {
     /// Reads up to a chunk from the source onto the window's end.
     fn read_chunk(&mut self) -> Result<(), ReadError> {
         let have = self.end - self.start;
-        let step = self.step;
-        self.step = (2 * step).min(self.chunk);
+        // The most the source can still give, as far as is known. Once it is reached
+        // the next read should find the end; if it does not, the bound was wrong (a
+        // file that grew) and reads go on as if none were known.
+        let unread = self.could_hold() - have;
+        let step = if unread > 0 {
+            self.step.min(unread)
+        } else {
+            self.step
+        };
+        self.step = (2 * self.step).min(self.chunk);
         if self.buf.len() - self.end < step {
             // Move the window to the front, and grow the buffer only when the window
-            // itself fills it (a record or list longer than a chunk): doubling, so
-            // what grows is what has arrived, whatever a header claimed.
-            self.buf.copy_within(self.start..self.end, 0);
-            (self.start, self.end) = (0, have);
-            if self.buf.len() - self.end < step {
-                let len = (self.end + step).max(2 * self.buf.len());
-                self.buf.resize(len, 0);
+            // itself fills it (a record or line longer than a chunk), so what grows is
+            // what has arrived, whatever a header claimed.
+            if self.start > 0 {
+                self.buf.copy_within(self.start..self.end, 0);
+                (self.start, self.end) = (0, have);
+            }
+            let need = self.end + step;
+            if self.buf.len() < need {
+                // Room doubles, so a long line costs linear copies, but not past what
+                // the rest of the data can hold; and only what this read may fill is
+                // written (zeroed): the line costs about itself, not twice it.
+                if need > self.buf.capacity() {
+                    let mut room = (2 * self.buf.capacity()).max(need);
+                    if unread > 0 {
+                        room = room.min(self.end.saturating_add(unread)).max(need);
+                    }
+                    self.buf.reserve_exact(room - self.buf.len());
+                }
+                self.buf.resize(need, 0);
             }
         }
         let space = self.end..self.buf.len().min(self.end + step);
@@ -960,18 +980,23 @@ mod tests {
     }
 
     /// A text line longer than a chunk is held whole, and only it: the window's buffer
-    /// grows by doubling to about the line and a read, not to the file's size (here
-    /// 2.5 MB, of lines gzip cannot shrink past its cap).
+    /// is written (zero-filled, then read into) up to about the line and a read, not
+    /// to twice the line nor to the file's size (here 2.5 MB, of lines gzip cannot
+    /// shrink past its cap); and when the line is about all the file holds, its
+    /// room is not reserved past the file's end.
     #[test]
     fn a_long_line_costs_the_line_not_the_file() {
         let line = 300_000;
-        let data = format!(
-            "OFF\n# {}\n3 1\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n{}",
-            "x".repeat(line),
-            (0..200_000)
-                .map(|i| format!("after {i}\n"))
-                .collect::<String>()
-        );
+        let off = |after: &str| {
+            format!(
+                "OFF\n# {}\n3 1\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n{after}",
+                "x".repeat(line)
+            )
+        };
+        let many = (0..200_000)
+            .map(|i| format!("after {i}\n"))
+            .collect::<String>();
+        let data = off(&many);
         for data in [data.as_bytes().to_vec(), gzip(data.as_bytes())] {
             let mut input =
                 Input::reader(Box::new(&data[..]), data.len() as u64, 4096).expect("memory reads");
@@ -979,8 +1004,17 @@ mod tests {
             assert_eq!(loaded.mesh.triangles, vec![[0, 1, 2]]);
             assert_eq!(loaded.notes.skipped_lines, 200_000);
             assert!(input.buf.len() > line, "the line is held whole");
-            assert!(input.buf.len() <= 2 * (line + 4096), "{}", input.buf.len());
+            assert!(input.buf.len() <= line + 3 * 4096, "{}", input.buf.len());
         }
+        let data = off("");
+        let mut input = Input::reader(Box::new(data.as_bytes()), data.len() as u64, 4096)
+            .expect("memory reads");
+        read_input(&mut input, Format::Off, None).expect("a valid OFF");
+        assert!(
+            input.buf.capacity() <= data.len() + 1,
+            "{}",
+            input.buf.capacity()
+        );
     }
 
     /// Every truncation of every input, plain and gzipped, each with one of the chunk

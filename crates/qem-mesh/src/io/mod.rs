@@ -45,8 +45,10 @@
 //! at its end, beyond what has arrived: the arrays grow as the data arrives); gzip
 //! output is capped at [`GZIP_MAX_RATIO`] times the compressed size and at
 //! [`GZIP_MAX_BYTES`]. A streamed binary PLY record, and a text line (or token), is
-//! held whole before it is read, so a list or a line that claims more than the file
-//! holds costs at most the rest of the file.
+//! held whole before it is read: the window's buffer then grows to about that record
+//! or line and one read (not to twice it: room doubles, but only what a read fills is
+//! written), and never past what the rest of the data can hold, so a list that claims
+//! more than the file holds costs at most the rest of the file.
 //!
 //! # Writing
 //! [`write_to`] writes any format to a `Write`; [`write_path`] writes a file
