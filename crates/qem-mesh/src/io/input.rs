@@ -569,6 +569,104 @@ mod tests {
         got
     }
 
+    /// The text readers' edge cases give, every way they are read (so with `\r\n`
+    /// and tokens cut between reads), what the readers that parsed all the bytes at
+    /// once gave: the expected values were printed by 69c3ccb's `read_bytes`. A last
+    /// line that is not UTF-8 without a line break, a byte order mark, the end of the
+    /// data inside a token (valid, a bad number, a cut list, a cut keyword).
+    #[test]
+    fn text_edge_cases_give_what_the_whole_buffer_readers_gave() {
+        let cases: [(Format, &[u8], &str); 15] = [
+            (
+                Format::Off,
+                &b"\xef\xbb\xbfOFF\r\n3 1 0\r\n0 0 0\r\n1 0 0\r\n0 1 0\r\n3 0 1 2\r\njunk caf\xe9"[..],
+                "OK tris=[[0, 1, 2]] pos=[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] notes=ReadNotes { skipped_lines: 1, skipped_properties: 0, skipped_primitives: 0, non_utf8_lines: 1, byte_order_mark: true }",
+            ),
+            (
+                Format::Off,
+                &b"OFF\r\n3 1 0\r\n0 0 0\r\n1 0 0\r\n0 1 0\r\n3 0 1"[..],
+                "ERR line 6: face 0: expected 3 vertex indices, found 2",
+            ),
+            (
+                Format::Off,
+                &b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0.5e"[..],
+                "ERR line 5: vertex 2: bad coordinate \"0.5e\"",
+            ),
+            (
+                Format::Off,
+                &b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2"[..],
+                "OK tris=[[0, 1, 2]] pos=[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] notes=ReadNotes { skipped_lines: 0, skipped_properties: 0, skipped_primitives: 0, non_utf8_lines: 0, byte_order_mark: false }",
+            ),
+            (
+                Format::Off,
+                &b"OFF\r\n3 1 0\r\n0 0 0\r\n1 0 0\r\n0 1 0\r\n3 0 1 2\r\n# caf\xe9"[..],
+                "OK tris=[[0, 1, 2]] pos=[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] notes=ReadNotes { skipped_lines: 0, skipped_properties: 0, skipped_primitives: 0, non_utf8_lines: 1, byte_order_mark: false }",
+            ),
+            (
+                Format::Ply,
+                &b"\xef\xbb\xbfply\r\nformat ascii 1.0\r\ncomment caf\xe9\r\nelement vertex 3\r\nproperty float x\r\nproperty float y\r\nproperty float z\r\nelement face 1\r\nproperty list uchar int vertex_indices\r\nend_header\r\n0 0 0\r\n1 0 0\r\n0 1 0\r\n3 0 1 2\r\n"[..],
+                "OK tris=[[0, 1, 2]] pos=[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] notes=ReadNotes { skipped_lines: 0, skipped_properties: 0, skipped_primitives: 0, non_utf8_lines: 1, byte_order_mark: true }",
+            ),
+            (
+                Format::Ply,
+                &b"ply\r\nformat ascii 1.0\r\ncomment caf\xe9\r\nelement vertex 3\r\nproperty float x\r\nproperty float y\r\nproperty float z\r\nelement face 1\r\nproperty list uchar int vertex_indices\r\nend_header\r\n0 0 0\r\n1 0 0\r\n0 1 0\r\n3 0 1"[..],
+                "ERR line 14: unexpected end of file in face 0: its list claims 3 items, more than the rest of the file can hold",
+            ),
+            (
+                Format::Ply,
+                &b"ply\r\nformat ascii 1.0\r\ncomment caf\xe9\r\nelement vertex 3\r\nproperty float x\r\nproperty float y\r\nproperty float z\r\nelement face 1\r\nproperty list uchar int vertex_indices\r\nend_header\r\n0 0 0\r\n1 0 0\r\n0 1 0.5e"[..],
+                "ERR line 13: vertex 2: bad coordinate \"0.5e\"",
+            ),
+            (
+                Format::Ply,
+                &b"ply\r\nformat ascii 1.0\r\ncomment caf\xe9\r\nelement vertex 3\r\nproperty float x\r\nproperty float y\r\nproperty float z\r\nelement face 1\r\nproperty list uchar int vertex_indices\r\nend_header\r\n0 0 0\r\n1 0 0\r\n0 1 0\r\n3 0 1 2"[..],
+                "OK tris=[[0, 1, 2]] pos=[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] notes=ReadNotes { skipped_lines: 0, skipped_properties: 0, skipped_primitives: 0, non_utf8_lines: 1, byte_order_mark: false }",
+            ),
+            (
+                Format::Ply,
+                &b"ply\r\nformat ascii 1.0\r\ncomment caf\xe9\r\nelement vertex 3\r\nproperty float x\r\nproperty float y\r\nproperty float z\r\nelement face 1\r\nproperty list uchar int vertex_indices\r\nend_header\r\n0 0 0\r\n1 0 0\r\n0 1 0\r\n3 0 1 2\r\ncaf\xe9"[..],
+                "OK tris=[[0, 1, 2]] pos=[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] notes=ReadNotes { skipped_lines: 0, skipped_properties: 0, skipped_primitives: 0, non_utf8_lines: 1, byte_order_mark: false }",
+            ),
+            (
+                Format::Stl,
+                &b"\xef\xbb\xbfsolid x\r\n facet normal 0 0 1\r\n  outer loop\r\n   vertex 0 0 0\r\n   vertex 1 0 0\r\n   vertex 0 1 0\r\n  endloop\r\n endfacet\r\n facet normal 0 0 1\r\n  outer loop\r\n   vertex 0 0 0\r\n   vertex 1 0 0\r\n   vertex 0 1 0\r\n  endloop\r\n endfacet\r\nendsolid caf\xe9"[..],
+                "OK tris=[[0, 1, 2], [3, 4, 5]] pos=[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] notes=ReadNotes { skipped_lines: 0, skipped_properties: 0, skipped_primitives: 0, non_utf8_lines: 1, byte_order_mark: true }",
+            ),
+            (
+                Format::Stl,
+                &b"solid x\r\n facet normal 0 0 1\r\n  outer loop\r\n   vertex 0 0 0\r\n   vertex 1 0 0\r\n   vertex 0 1 0\r\n  endloop\r\n endfacet\r\n facet normal 0 0 1\r\n  outer loop\r\n   vertex 0 0 0\r\n   vertex 1 0 0\r\n   vertex 0 1 0\r\n  endloop\r\n endfacet\r\nendsolid"[..],
+                "OK tris=[[0, 1, 2], [3, 4, 5]] pos=[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] notes=ReadNotes { skipped_lines: 0, skipped_properties: 0, skipped_primitives: 0, non_utf8_lines: 0, byte_order_mark: false }",
+            ),
+            (
+                Format::Stl,
+                &b"solid x\r\n facet normal 0 0 1\r\n  outer loop\r\n   vertex 0 0 0\r\n   vertex 1 0 0\r\n   vertex 0 1 0\r\n  endloop\r\n endfacet\r\n facet normal 0 0 1\r\n  outer loop\r\n   vertex 0 0 0\r\n   vertex 1 0 0\r\n   vertex 0 1 0\r\n  endloop\r\n endfacet\r\n facet normal 0 0 1\r\n  outer loop\r\n   vertex 0 0 0\r\n   vertex 1 0 0\r\n   vertex 0 1 0.5e"[..],
+                "ERR line 20: facet 2, vertex 2: coordinate 2 is \"0.5e\", not a number",
+            ),
+            (
+                Format::Stl,
+                &b"solid x\r\n facet normal 0 0 1\r\n  outer loop\r\n   vertex 0 0 0\r\n   vertex 1 0 0\r\n   vertex 0 1 0\r\n  endloop\r\n endfacet\r\n facet normal 0 0 1\r\n  outer loop\r\n   vertex 0 0 0\r\n   vertex 1 0 0\r\n   vertex 0 1 0\r\n  endloop\r\n endfacet\r\n facet normal 0 0 1\r\n  outer loop\r\n   vertex 0 0 0\r\n   vertex 1 0 0\r\n   vertex 0 1"[..],
+                "ERR line 20: facet 2, vertex 2: coordinate 2 is \"\", not a number",
+            ),
+            (
+                Format::Stl,
+                &b"solid x\r\n facet normal 0 0 1\r\n  outer loop\r\n   vertex 0 0 0\r\n   vertex 1 0 0\r\n   vertex 0 1 0\r\n  endloop\r\n endfacet\r\n facet normal 0 0 1\r\n  outer loop\r\n   vertex 0 0 0\r\n   vertex 1 0 0\r\n   vertex 0 1 0\r\n  endloop\r\n endfacet\r\n facet normal 0 0 1\r\n  outer loop\r\n   vertex 0 0 0\r\n   vertex 1 0 0\r\n   vertex 0 1 0\r\n  endlo"[..],
+                "ERR line 21: unexpected end of file inside facet 2",
+            ),
+        ];
+        for (format, data, want) in cases {
+            for (how, got) in every_way(data, format) {
+                let got = match got {
+                    Ok(l) => format!(
+                        "OK tris={:?} pos={:?} notes={:?}",
+                        l.mesh.triangles, l.mesh.positions, l.notes
+                    ),
+                    Err(e) => format!("ERR {e}"),
+                };
+                assert_eq!(got, want, "{how}: {data:?}");
+            }
+        }
+    }
+
     /// ASCII STL whose last line is not UTF-8 and has no line break: that line is
     /// counted in `non_utf8_lines`, with and without a byte order mark, as the readers
     /// that parsed all the bytes at once counted it (values from 69c3ccb).
