@@ -84,7 +84,7 @@ pub(crate) struct Input<'a> {
     chunk: usize,
     /// Bytes asked of the source by the next read (from [`FIRST_READ`] up to `chunk`).
     step: usize,
-    /// The size the data is expected to have, for reservations only: exact in memory,
+    /// The most bytes the data can have (see [`Input::could_hold`]): exact in memory,
     /// the file's size for a plain file, unknown (`None`) for gzip.
     expected: Option<u64>,
     /// The first error of the source, given again by every later call.
@@ -129,8 +129,10 @@ impl<'a> Input<'a> {
     /// The data of `reader`, decompressed as it is read when it starts with the gzip
     /// magic; bytes are asked of the reader `chunk` at a time. `len` is the size of
     /// what the reader gives: for gzip data it must be exact (it sets the cap on what
-    /// the data may decompress to); for plain data it is a guess, which only sizes
-    /// reservations.
+    /// the data may decompress to); for plain data it must be at least the size (an
+    /// upper bound): it is [`Input::could_hold`]'s, which sizes reservations and the
+    /// buffer's growth, and on which the STL reader decides whether text could be a
+    /// binary file's size.
     pub(crate) fn reader(
         mut reader: Box<dyn Read + 'a>,
         len: u64,
@@ -212,10 +214,11 @@ impl<'a> Input<'a> {
         self.eof
     }
 
-    /// The most bytes the rest of the data can hold, as far as is known: what bounds the
-    /// room reserved for what a header claims. Exact in memory, the rest of the file's
-    /// size for a plain file, and for gzip (whose size is known only at its end) the
-    /// rest of what its cap allows. (Reserving for gzip data only as it arrives, and
+    /// The most bytes the rest of the data can hold, as far as is known: an upper bound
+    /// of its size (readers rely on it), which bounds the room reserved for what a
+    /// header claims. Exact in memory, the rest of the file's size for a plain file
+    /// (the size given to [`Input::reader`]), and for gzip (whose size is known only
+    /// at its end) the rest of what its cap allows. (Reserving for gzip data only as it arrives, and
     /// growing, measured 10% slower on a 2M-triangle binary PLY; what is reserved and
     /// never filled takes address space, not memory.)
     pub(crate) fn could_hold(&self) -> usize {
@@ -496,18 +499,19 @@ mod tests {
     const CHUNKS: [usize; 6] = [1, 2, 3, 7, 50, 4096];
 
     /// `data` read from a reader `chunk` bytes at a time; `sized`: with the data's size
-    /// known beforehand, as for a file (otherwise as for a pipe).
+    /// known beforehand, as for a file (otherwise only an upper bound of it).
     fn chunked(
         data: &[u8],
         format: Format,
         chunk: usize,
         sized: bool,
     ) -> Result<LoadedMesh, ReadError> {
-        // Gzip's cap needs the compressed size; plain data's size only sizes reservations.
+        // Gzip's cap needs the compressed size; plain data's needs to be an upper bound
+        // (a file's size), which here is exact or not.
         let len = if sized || is_gzip(data) {
             data.len() as u64
         } else {
-            0
+            2 * data.len() as u64 + 4096
         };
         let mut input = Input::reader(Box::new(data), len, chunk).expect("memory reads");
         read_input(&mut input, format, None)

@@ -426,7 +426,8 @@ mod tests {
         for text in texts {
             let text = [text, b"\n", text].concat();
             for chunk in [1, 2, 3, 7, 4096] {
-                let mut input = Input::reader(Box::new(&text[..]), 0, chunk).expect("memory reads");
+                let mut input =
+                    Input::reader(Box::new(&text[..]), u64::MAX, chunk).expect("memory reads");
                 let mut stream = TextStream::new(&mut input, 1);
                 stream.count_non_utf8();
                 let mut got = Vec::new();
@@ -486,7 +487,7 @@ mod tests {
             for count in [false, true] {
                 for chunk in [1, 3, 4096] {
                     let mut input =
-                        Input::reader(Box::new(&data[..]), 0, chunk).expect("memory reads");
+                        Input::reader(Box::new(&data[..]), u64::MAX, chunk).expect("memory reads");
                     input.fill(3).expect("memory reads");
                     input.consume(if bom { 3 } else { 0 });
                     let mut stream = TextStream::new(&mut input, 1);
@@ -521,7 +522,7 @@ mod tests {
             let began = std::time::Instant::now();
             for lines in [true, false] {
                 let mut input =
-                    Input::reader(Box::new(text.as_bytes()), 0, 64).expect("memory reads");
+                    Input::reader(Box::new(text.as_bytes()), u64::MAX, 64).expect("memory reads");
                 let mut stream = TextStream::new(&mut input, 1);
                 stream.count_non_utf8();
                 let mut longest = 0;
@@ -561,7 +562,7 @@ mod tests {
         let text = format!(" a\r\n\n\t bc  d\nsolid name \u{e9} x\n{long}\n\n e");
         for chunk in [1, 2, 3, 7, 4096] {
             let data = text.as_bytes();
-            let mut input = Input::reader(Box::new(data), 0, chunk).expect("memory reads");
+            let mut input = Input::reader(Box::new(data), u64::MAX, chunk).expect("memory reads");
             let mut stream = TextStream::new(&mut input, 1);
             let mut got = Vec::new();
             while let Some((token, line)) = stream.next_token().expect("memory reads") {
