@@ -14,11 +14,20 @@
 //! at a time, so reading a file takes about the memory of the arrays it gives, not the
 //! file's (or its decompressed data's) size on top (a 4M-triangle sphere: 1.04 times
 //! the arrays as OFF or ASCII PLY, 1.01 as ASCII STL, where it was 2.7 and 3.1 times;
-//! figures in BENCHMARKS.md, "Loading"). OBJ and glTF are parsed from all
-//! their (decompressed) bytes at once. Whatever the form, the result and the errors are
-//! those of reading the whole data at once: an error that depends on what comes later
-//! (a cut element, a binary STL's size, an ASCII PLY list longer than the rest of the
-//! file, a corrupt gzip stream) is given once the rest has been read.
+//! figures in BENCHMARKS.md, "Loading"). A line (or token) longer than a chunk is
+//! held whole while it is read, costing about its length. Parsed from all their
+//! (decompressed) bytes at once: OBJ and glTF; an ASCII STL whose bytes 80..84 (control
+//! bytes there, not text) give a binary STL count of at most `MAX_ELEMENTS` triangles
+//! and a size the data could have, since only its end says whether it is a binary
+//! file; and STL text with more than 4 KiB of whitespace before `solid`. Whatever the
+//! form, the result and the errors are those of reading the whole data at once: an
+//! error that depends on what comes later (a cut element, a binary STL's size, an
+//! ASCII PLY list longer than the rest of the file, a corrupt gzip stream) is given
+//! once the rest has been read. One difference: a plain file's read error in a part
+//! the reader never reaches (after an error in the content, or after a PLY file's
+//! last element) is not seen, so the content's error stands, as it did for binary PLY
+//! and STL (before the text formats streamed, their whole file was read first and its
+//! read error won); gzip data is always read to its end.
 //!
 //! Polygons are fan-triangulated from their first corner. Vertices are never welded
 //! or removed by the PLY, STL and OFF readers (an STL facet gives three new vertices);
