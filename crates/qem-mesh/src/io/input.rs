@@ -23,9 +23,9 @@ use super::{ReadError, ReadErrorKind, BOM, GZIP_MAX_BYTES, GZIP_MAX_RATIO};
 /// parsing what it brings, small enough to be nothing next to a mesh's arrays.
 const CHUNK: usize = 1 << 20;
 
-/// Bytes asked of the source first; each read asks twice as many, up to the chunk, so a
+/// Bytes asked of gzip data first; each read asks twice as many, up to the chunk, so a
 /// small file does not pay for a buffer of a chunk (measured: about 1% of reading a
-/// 50k-triangle gzipped STL).
+/// 50k-triangle gzipped STL). A plain file asks its size first (at most a chunk).
 const FIRST_READ: usize = 1 << 16;
 
 /// Where the bytes come from.
@@ -153,7 +153,14 @@ impl<'a> Input<'a> {
         Ok(if is_gzip(&magic[..got]) {
             Input::gzip(whole, len, chunk)
         } else {
-            Input::new(Source::Plain(whole), false, Some(len), chunk)
+            let mut input = Input::new(Source::Plain(whole), false, Some(len), chunk);
+            // A file smaller than a chunk is read in one read into a buffer of its
+            // size, not in reads doubling from `FIRST_READ` (the mannequin OFF, 1 MB:
+            // see BENCHMARKS.md, "Loading").
+            input.step = usize::try_from(len)
+                .unwrap_or(usize::MAX)
+                .clamp(1, input.chunk);
+            input
         })
     }
 
@@ -1117,6 +1124,19 @@ mod tests {
             "{}",
             input.buf.capacity()
         );
+    }
+
+    /// A plain file smaller than a chunk is read into one buffer of its size in one
+    /// read (after the two bytes that tell gzip), not in reads doubling from
+    /// `FIRST_READ`.
+    #[test]
+    fn a_file_smaller_than_a_chunk_is_read_at_once() {
+        let data = vec![b'x'; 200_000];
+        let mut input =
+            Input::reader(Box::new(&data[..]), data.len() as u64, CHUNK).expect("memory reads");
+        input.fill(3).expect("memory reads");
+        assert_eq!(input.window().len(), data.len());
+        assert_eq!(input.buf.capacity(), data.len());
     }
 
     /// Every truncation of every input, plain and gzipped, each with one of the chunk
