@@ -663,7 +663,7 @@ pub(crate) fn sniff_start(head: &[u8], solid: bool) -> Option<&'static str> {
     if let Some((_, what)) = MAGIC.iter().find(|(m, _)| head.starts_with(m)) {
         return Some(what);
     }
-    if head.starts_with(b"ply\n") || head.starts_with(b"ply\r\n") {
+    if ply::starts_ply(head) {
         return Some("a PLY file");
     }
     let head = &head[..head.len().min(SNIFF_HEAD)];

@@ -369,11 +369,10 @@ fn next_content<'s>(
         if solid.is_none() && !text::trim(raw).is_empty() {
             *solid = Some(starts_solid(text::trim_start(raw)));
         }
-        let content = text::trim(text::strip_comment(raw, b'#'));
+        let content = text::trimmed(text::strip_comment(raw, b'#'));
         if !content.is_empty() {
-            // `content` is a part of `raw`: where it starts in the span.
-            let start = span.start + (content.as_ptr() as usize - raw.as_ptr() as usize);
-            return Ok(Some((no, lines.span(start..start + content.len()))));
+            let at = span.start;
+            return Ok(Some((no, lines.span(at + content.start..at + content.end))));
         }
     }
 }

@@ -134,8 +134,13 @@ struct Header<'a> {
     body_line: usize,
 }
 
+/// Whether `bytes` start with PLY's magic line (`ply` and a line break).
+pub(crate) fn starts_ply(bytes: &[u8]) -> bool {
+    bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n")
+}
+
 fn parse_header<'a>(bytes: &'a [u8], notes: &mut ReadNotes) -> Result<Header<'a>, ReadError> {
-    if !(bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n")) {
+    if !starts_ply(bytes) {
         return Err(not_ply(sniff(bytes)));
     }
     let mut encoding = None;
@@ -705,8 +710,7 @@ pub(crate) const HEADER_PREFIX: usize = 1 << 16;
 /// at a time, an ASCII one a token at a time.
 pub(crate) fn read(input: &mut Input<'_>, notes: &mut ReadNotes) -> Result<IndexedMesh, ReadError> {
     input.fill(b"ply\r\n".len())?;
-    let start = input.window();
-    if !(start.starts_with(b"ply\n") || start.starts_with(b"ply\r\n")) {
+    if !starts_ply(input.window()) {
         return Err(not_ply(sniff_input(input)?));
     }
     let mut want = HEADER_PREFIX;

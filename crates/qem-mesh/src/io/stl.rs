@@ -16,17 +16,15 @@ use std::io::Write;
 
 use super::input::Input;
 use super::text::{self, capacity_for, parse_f64, show, TextStream};
-use super::{sniff, strip_bom, Format, Location, ReadError, ReadNotes};
+use super::{sniff, strip_bom, Format, Location, ReadError, ReadNotes, BOM, SNIFF_HEAD};
 use crate::{IndexedMesh, InputError, MAX_ELEMENTS};
 
 const HEADER: usize = 84;
-/// Bytes of the UTF-8 byte order mark an ASCII STL file may start with.
-const BOM_LEN: usize = 3;
 const RECORD: usize = 50;
 
 /// What the start of the data must hold for [`sniff`] and the NUL test below to see
-/// what they would see in the whole data: a byte order mark and 4096 bytes.
-const START: usize = BOM_LEN + 4096;
+/// what they would see in the whole data: a byte order mark and what `sniff` looks at.
+const START: usize = BOM.len() + SNIFF_HEAD;
 
 /// Reads an STL file as it arrives: binary STL whole records at a time, ASCII STL a
 /// token at a time.
@@ -34,7 +32,7 @@ pub(crate) fn read(input: &mut Input<'_>, notes: &mut ReadNotes) -> Result<Index
     input.fill(START)?;
     let window = input.window();
     let (text, bom) = strip_bom(window);
-    // `sniff` looks past the first 4096 bytes only to skip leading whitespace.
+    // `sniff` looks past its first `SNIFF_HEAD` bytes only to skip leading whitespace.
     let decided = input.at_end() || text::trim_start(text).len() >= 5;
     let count = window
         .get(80..84)
@@ -59,7 +57,7 @@ pub(crate) fn read(input: &mut Input<'_>, notes: &mut ReadNotes) -> Result<Index
             notes.byte_order_mark = bom;
             // Unlike `skip_bom`, offsets keep counting the mark: the size compared is
             // the whole data's.
-            input.consume(if bom { BOM_LEN } else { 0 });
+            input.consume(if bom { BOM.len() } else { 0 });
             let mut tok = TextStream::new(input, 1);
             tok.count_non_utf8();
             let read = read_ascii(&mut tok, notes);

@@ -126,12 +126,18 @@ pub(crate) fn trim_start(s: &[u8]) -> &[u8] {
 
 /// `s` without leading and trailing ASCII whitespace.
 pub(crate) fn trim(s: &[u8]) -> &[u8] {
-    let s = trim_start(s);
+    &s[trimmed(s)]
+}
+
+/// Where `s` lies without leading and trailing ASCII whitespace (empty when it is all
+/// whitespace).
+pub(crate) fn trimmed(s: &[u8]) -> std::ops::Range<usize> {
+    let i = s.len() - trim_start(s).len();
     let j = s
         .iter()
         .rposition(|b| !b.is_ascii_whitespace())
-        .map_or(0, |j| j + 1);
-    &s[..j]
+        .map_or(i, |j| j + 1);
+    i..j
 }
 
 /// `line` cut at the first `comment` byte.
