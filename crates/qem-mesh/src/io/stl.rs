@@ -61,8 +61,8 @@ pub(crate) fn read(input: &mut Input<'_>, notes: &mut ReadNotes) -> Result<Index
             let mut tok = TextStream::new(input, 1);
             tok.count_non_utf8();
             let read = read_ascii(&mut tok, notes);
-            // Counted before `count_rest`, which consumes the cursor's line: a last
-            // line without a line break would go uncounted.
+            // Counted before `count_rest`, which skips what is left without counting
+            // it (a last line without a line break went uncounted that way).
             let non_utf8 = tok.non_utf8_lines();
             if maybe_binary && tok.offset() + tok.count_rest()? == expected_len(n) {
                 return Err(too_many_binary(n));
