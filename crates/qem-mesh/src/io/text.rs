@@ -510,13 +510,13 @@ mod tests {
         }
     }
 
-    /// A line (or token) much longer than a read costs time in proportion to its
-    /// length: the search for its end resumes where the last read left it, and the
-    /// lines that are not UTF-8 are counted as the bytes pass. Before, each read
-    /// searched the line again from its start: here 2^14 reads of a 1 MiB line, some
-    /// 8 GiB of bytes looked at (tens of seconds in a debug build; now well under one).
+    /// A line (or token) much longer than a read comes out whole, read 64 bytes at a
+    /// time. (Its cost is its length: the search for its end resumes where the last
+    /// read left it. Before, each read searched the line again from its start: 2^14
+    /// reads of this 1 MiB line looked at some 8 GiB, tens of seconds in a debug
+    /// build. Not asserted here, a time bound being a flaky test; measured in d0d1c64.)
     #[test]
-    fn a_long_line_read_in_small_pieces_costs_its_length() {
+    fn a_long_line_read_in_small_pieces_comes_out_whole() {
         let long = "x".repeat(1 << 20);
         let crs = "\r".repeat(1 << 20);
         let cases = [
@@ -525,7 +525,6 @@ mod tests {
             format!("a {long} b"),
         ];
         for text in &cases {
-            let began = std::time::Instant::now();
             for lines in [true, false] {
                 let mut input =
                     Input::reader(Box::new(text.as_bytes()), u64::MAX, 64).expect("memory reads");
@@ -545,8 +544,6 @@ mod tests {
                 assert!(longest >= (1 << 20) - 1 || short, "{longest}");
                 assert_eq!(stream.non_utf8_lines(), 0);
             }
-            let took = began.elapsed();
-            assert!(took.as_secs_f64() < 5.0, "{took:?}");
         }
     }
 
