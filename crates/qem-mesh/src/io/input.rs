@@ -4,8 +4,9 @@
 //! so many ([`Input::fill`]), parses whole records out of the window, and consumes them
 //! ([`Input::consume`]); the window is refilled from the source a chunk at a time, so a
 //! binary PLY or STL file is read without holding the file, or its decompressed bytes,
-//! in memory. Data in memory is its own window (nothing is copied), and a reader that
-//! needs all of its data at once (the text formats, glTF) takes the rest with
+//! in memory. OFF, ASCII PLY and ASCII STL read whole lines or tokens out of the window
+//! the same way ([`super::text::TextStream`]). Data in memory is its own window (nothing is copied),
+//! and a reader that needs all of its data at once (OBJ, glTF) takes the rest with
 //! [`Input::rest`].
 //!
 //! Gzip data is decompressed as it is read, with the caps of [`GZIP_MAX_RATIO`] and
@@ -22,9 +23,9 @@ use super::{ReadError, ReadErrorKind, BOM, GZIP_MAX_BYTES, GZIP_MAX_RATIO};
 /// parsing what it brings, small enough to be nothing next to a mesh's arrays.
 const CHUNK: usize = 1 << 20;
 
-/// Bytes asked of the source first; each read asks twice as many, up to the chunk, so a
+/// Bytes asked of gzip data first; each read asks twice as many, up to the chunk, so a
 /// small file does not pay for a buffer of a chunk (measured: about 1% of reading a
-/// 50k-triangle gzipped STL).
+/// 50k-triangle gzipped STL). A plain file asks its size first (at most a chunk).
 const FIRST_READ: usize = 1 << 16;
 
 /// Where the bytes come from.
@@ -83,7 +84,7 @@ pub(crate) struct Input<'a> {
     chunk: usize,
     /// Bytes asked of the source by the next read (from [`FIRST_READ`] up to `chunk`).
     step: usize,
-    /// The size the data is expected to have, for reservations only: exact in memory,
+    /// The most bytes the data can have (see [`Input::could_hold`]): exact in memory,
     /// the file's size for a plain file, unknown (`None`) for gzip.
     expected: Option<u64>,
     /// The first error of the source, given again by every later call.
@@ -108,15 +109,6 @@ impl<'a> Input<'a> {
         Input::new(Source::Memory(data), true, Some(data.len() as u64), CHUNK)
     }
 
-    /// [`Input::plain`] for data that starts at `offset` of a larger whole (errors give
-    /// places in the whole).
-    pub(crate) fn plain_at(data: &'a [u8], offset: u64) -> Input<'a> {
-        let mut input = Input::plain(data);
-        input.offset = offset;
-        input.expected = Some(offset + data.len() as u64);
-        input
-    }
-
     /// The data of a file, decompressed as it is read when it starts with the gzip
     /// magic.
     pub(crate) fn file(file: std::fs::File) -> std::io::Result<Input<'static>> {
@@ -137,8 +129,10 @@ impl<'a> Input<'a> {
     /// The data of `reader`, decompressed as it is read when it starts with the gzip
     /// magic; bytes are asked of the reader `chunk` at a time. `len` is the size of
     /// what the reader gives: for gzip data it must be exact (it sets the cap on what
-    /// the data may decompress to); for plain data it is a guess, which only sizes
-    /// reservations.
+    /// the data may decompress to); for plain data it must be at least the size (an
+    /// upper bound): it is [`Input::could_hold`]'s, which sizes reservations and the
+    /// buffer's growth, and on which the STL reader decides whether text could be a
+    /// binary file's size.
     pub(crate) fn reader(
         mut reader: Box<dyn Read + 'a>,
         len: u64,
@@ -159,7 +153,14 @@ impl<'a> Input<'a> {
         Ok(if is_gzip(&magic[..got]) {
             Input::gzip(whole, len, chunk)
         } else {
-            Input::new(Source::Plain(whole), false, Some(len), chunk)
+            let mut input = Input::new(Source::Plain(whole), false, Some(len), chunk);
+            // A file smaller than a chunk is read in one read into a buffer of its
+            // size, not in reads doubling from `FIRST_READ` (the mannequin OFF, 1 MB:
+            // see BENCHMARKS.md, "Loading").
+            input.step = usize::try_from(len)
+                .unwrap_or(usize::MAX)
+                .clamp(1, input.chunk);
+            input
         })
     }
 
@@ -201,6 +202,7 @@ impl<'a> Input<'a> {
     }
 
     /// The bytes read and not yet consumed.
+    #[inline]
     pub(crate) fn window(&self) -> &[u8] {
         match &self.source {
             Source::Memory(rest) => rest,
@@ -214,14 +216,16 @@ impl<'a> Input<'a> {
     }
 
     /// Whether the window holds all the data that is left.
+    #[inline]
     pub(crate) fn at_end(&self) -> bool {
         self.eof
     }
 
-    /// The most bytes the rest of the data can hold, as far as is known: what bounds the
-    /// room reserved for what a header claims. Exact in memory, the rest of the file's
-    /// size for a plain file, and for gzip (whose size is known only at its end) the
-    /// rest of what its cap allows. (Reserving for gzip data only as it arrives, and
+    /// The most bytes the rest of the data can hold, as far as is known: an upper bound
+    /// of its size (readers rely on it), which bounds the room reserved for what a
+    /// header claims. Exact in memory, the rest of the file's size for a plain file
+    /// (the size given to [`Input::reader`]), and for gzip (whose size is known only
+    /// at its end) the rest of what its cap allows. (Reserving for gzip data only as it arrives, and
     /// growing, measured 10% slower on a 2M-triangle binary PLY; what is reserved and
     /// never filled takes address space, not memory.)
     pub(crate) fn could_hold(&self) -> usize {
@@ -363,17 +367,37 @@ impl<'a> Input<'a> {
     /// Reads up to a chunk from the source onto the window's end.
     fn read_chunk(&mut self) -> Result<(), ReadError> {
         let have = self.end - self.start;
-        let step = self.step;
-        self.step = (2 * step).min(self.chunk);
+        // The most the source can still give, as far as is known. Once it is reached
+        // the next read should find the end; if it does not, the bound was wrong (a
+        // file that grew) and reads go on as if none were known.
+        let unread = self.could_hold() - have;
+        let step = if unread > 0 {
+            self.step.min(unread)
+        } else {
+            self.step
+        };
+        self.step = (2 * self.step).min(self.chunk);
         if self.buf.len() - self.end < step {
             // Move the window to the front, and grow the buffer only when the window
-            // itself fills it (a record or list longer than a chunk): doubling, so
-            // what grows is what has arrived, whatever a header claimed.
-            self.buf.copy_within(self.start..self.end, 0);
-            (self.start, self.end) = (0, have);
-            if self.buf.len() - self.end < step {
-                let len = (self.end + step).max(2 * self.buf.len());
-                self.buf.resize(len, 0);
+            // itself fills it (a record or line longer than a chunk), so what grows is
+            // what has arrived, whatever a header claimed.
+            if self.start > 0 {
+                self.buf.copy_within(self.start..self.end, 0);
+                (self.start, self.end) = (0, have);
+            }
+            let need = self.end + step;
+            if self.buf.len() < need {
+                // Room doubles, so a long line costs linear copies, but not past what
+                // the rest of the data can hold; and only what this read may fill is
+                // written (zeroed): the line costs about itself, not twice it.
+                if need > self.buf.capacity() {
+                    let mut room = (2 * self.buf.capacity()).max(need);
+                    if unread > 0 {
+                        room = room.min(self.end.saturating_add(unread)).max(need);
+                    }
+                    self.buf.reserve_exact(room - self.buf.len());
+                }
+                self.buf.resize(need, 0);
             }
         }
         let space = self.end..self.buf.len().min(self.end + step);
@@ -482,18 +506,19 @@ mod tests {
     const CHUNKS: [usize; 6] = [1, 2, 3, 7, 50, 4096];
 
     /// `data` read from a reader `chunk` bytes at a time; `sized`: with the data's size
-    /// known beforehand, as for a file (otherwise as for a pipe).
+    /// known beforehand, as for a file (otherwise only an upper bound of it).
     fn chunked(
         data: &[u8],
         format: Format,
         chunk: usize,
         sized: bool,
     ) -> Result<LoadedMesh, ReadError> {
-        // Gzip's cap needs the compressed size; plain data's size only sizes reservations.
+        // Gzip's cap needs the compressed size; plain data's needs to be an upper bound
+        // (a file's size), which here is exact or not.
         let len = if sized || is_gzip(data) {
             data.len() as u64
         } else {
-            0
+            2 * data.len() as u64 + 4096
         };
         let mut input = Input::reader(Box::new(data), len, chunk).expect("memory reads");
         read_input(&mut input, format, None)
@@ -515,6 +540,176 @@ mod tests {
         match (gzip_corrupt(&whole), gzip_corrupt(&parts)) {
             (Some(a), Some(b)) => assert_eq!(a, b, "{what}, chunk {chunk}, sized {sized}"),
             _ => assert_eq!(parts, whole, "{what}, chunk {chunk}, sized {sized}"),
+        }
+    }
+
+    /// `data` read every way a caller can, plain and gzipped: from memory
+    /// (`read_bytes`), from a file (`read_path`) and from a reader in chunks of each
+    /// size of [`CHUNKS`], with the size exact or only an upper bound; each result
+    /// named, an error as its message.
+    fn every_way(data: &[u8], format: Format) -> Vec<(String, Result<LoadedMesh, String>)> {
+        let dir = tempfile::tempdir().expect("a temporary directory");
+        let ext = match format {
+            Format::Off => "off",
+            Format::Ply => "ply",
+            Format::Stl => "stl",
+            _ => unreachable!("the streamed formats"),
+        };
+        let mut got = Vec::new();
+        for (kind, data) in [("plain", data.to_vec()), ("gzipped", gzip(data))] {
+            got.push((
+                format!("{kind} read_bytes"),
+                read_bytes(&data, format).map_err(|e| e.to_string()),
+            ));
+            let path = dir.path().join(format!("{kind}.{ext}"));
+            std::fs::write(&path, &data).expect("a temporary file");
+            let read = crate::io::read_path(&path).map_err(|e| match e {
+                crate::io::IoError::Read { source, .. } => source.to_string(),
+                other => other.to_string(),
+            });
+            got.push((format!("{kind} read_path"), read));
+            for chunk in CHUNKS {
+                for sized in [true, false] {
+                    got.push((
+                        format!("{kind} in chunks of {chunk}, sized {sized}"),
+                        chunked(&data, format, chunk, sized).map_err(|e| e.to_string()),
+                    ));
+                }
+            }
+        }
+        got
+    }
+
+    /// The text readers' edge cases give, every way they are read (so with `\r\n`
+    /// and tokens cut between reads), what the readers that parsed all the bytes at
+    /// once gave: the expected values were printed by 69c3ccb's `read_bytes`. A last
+    /// line that is not UTF-8 without a line break, a byte order mark, the end of the
+    /// data inside a token (valid, a bad number, a cut list, a cut keyword).
+    #[test]
+    fn text_edge_cases_give_what_the_whole_buffer_readers_gave() {
+        let cases: [(Format, &[u8], &str); 15] = [
+            (
+                Format::Off,
+                &b"\xef\xbb\xbfOFF\r\n3 1 0\r\n0 0 0\r\n1 0 0\r\n0 1 0\r\n3 0 1 2\r\njunk caf\xe9"[..],
+                "OK tris=[[0, 1, 2]] pos=[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] notes=ReadNotes { skipped_lines: 1, skipped_properties: 0, skipped_primitives: 0, non_utf8_lines: 1, byte_order_mark: true }",
+            ),
+            (
+                Format::Off,
+                &b"OFF\r\n3 1 0\r\n0 0 0\r\n1 0 0\r\n0 1 0\r\n3 0 1"[..],
+                "ERR line 6: face 0: expected 3 vertex indices, found 2",
+            ),
+            (
+                Format::Off,
+                &b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0.5e"[..],
+                "ERR line 5: vertex 2: bad coordinate \"0.5e\"",
+            ),
+            (
+                Format::Off,
+                &b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2"[..],
+                "OK tris=[[0, 1, 2]] pos=[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] notes=ReadNotes { skipped_lines: 0, skipped_properties: 0, skipped_primitives: 0, non_utf8_lines: 0, byte_order_mark: false }",
+            ),
+            (
+                Format::Off,
+                &b"OFF\r\n3 1 0\r\n0 0 0\r\n1 0 0\r\n0 1 0\r\n3 0 1 2\r\n# caf\xe9"[..],
+                "OK tris=[[0, 1, 2]] pos=[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] notes=ReadNotes { skipped_lines: 0, skipped_properties: 0, skipped_primitives: 0, non_utf8_lines: 1, byte_order_mark: false }",
+            ),
+            (
+                Format::Ply,
+                &b"\xef\xbb\xbfply\r\nformat ascii 1.0\r\ncomment caf\xe9\r\nelement vertex 3\r\nproperty float x\r\nproperty float y\r\nproperty float z\r\nelement face 1\r\nproperty list uchar int vertex_indices\r\nend_header\r\n0 0 0\r\n1 0 0\r\n0 1 0\r\n3 0 1 2\r\n"[..],
+                "OK tris=[[0, 1, 2]] pos=[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] notes=ReadNotes { skipped_lines: 0, skipped_properties: 0, skipped_primitives: 0, non_utf8_lines: 1, byte_order_mark: true }",
+            ),
+            (
+                Format::Ply,
+                &b"ply\r\nformat ascii 1.0\r\ncomment caf\xe9\r\nelement vertex 3\r\nproperty float x\r\nproperty float y\r\nproperty float z\r\nelement face 1\r\nproperty list uchar int vertex_indices\r\nend_header\r\n0 0 0\r\n1 0 0\r\n0 1 0\r\n3 0 1"[..],
+                "ERR line 14: unexpected end of file in face 0: its list claims 3 items, more than the rest of the file can hold",
+            ),
+            (
+                Format::Ply,
+                &b"ply\r\nformat ascii 1.0\r\ncomment caf\xe9\r\nelement vertex 3\r\nproperty float x\r\nproperty float y\r\nproperty float z\r\nelement face 1\r\nproperty list uchar int vertex_indices\r\nend_header\r\n0 0 0\r\n1 0 0\r\n0 1 0.5e"[..],
+                "ERR line 13: vertex 2: bad coordinate \"0.5e\"",
+            ),
+            (
+                Format::Ply,
+                &b"ply\r\nformat ascii 1.0\r\ncomment caf\xe9\r\nelement vertex 3\r\nproperty float x\r\nproperty float y\r\nproperty float z\r\nelement face 1\r\nproperty list uchar int vertex_indices\r\nend_header\r\n0 0 0\r\n1 0 0\r\n0 1 0\r\n3 0 1 2"[..],
+                "OK tris=[[0, 1, 2]] pos=[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] notes=ReadNotes { skipped_lines: 0, skipped_properties: 0, skipped_primitives: 0, non_utf8_lines: 1, byte_order_mark: false }",
+            ),
+            (
+                Format::Ply,
+                &b"ply\r\nformat ascii 1.0\r\ncomment caf\xe9\r\nelement vertex 3\r\nproperty float x\r\nproperty float y\r\nproperty float z\r\nelement face 1\r\nproperty list uchar int vertex_indices\r\nend_header\r\n0 0 0\r\n1 0 0\r\n0 1 0\r\n3 0 1 2\r\ncaf\xe9"[..],
+                "OK tris=[[0, 1, 2]] pos=[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] notes=ReadNotes { skipped_lines: 0, skipped_properties: 0, skipped_primitives: 0, non_utf8_lines: 1, byte_order_mark: false }",
+            ),
+            (
+                Format::Stl,
+                &b"\xef\xbb\xbfsolid x\r\n facet normal 0 0 1\r\n  outer loop\r\n   vertex 0 0 0\r\n   vertex 1 0 0\r\n   vertex 0 1 0\r\n  endloop\r\n endfacet\r\n facet normal 0 0 1\r\n  outer loop\r\n   vertex 0 0 0\r\n   vertex 1 0 0\r\n   vertex 0 1 0\r\n  endloop\r\n endfacet\r\nendsolid caf\xe9"[..],
+                "OK tris=[[0, 1, 2], [3, 4, 5]] pos=[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] notes=ReadNotes { skipped_lines: 0, skipped_properties: 0, skipped_primitives: 0, non_utf8_lines: 1, byte_order_mark: true }",
+            ),
+            (
+                Format::Stl,
+                &b"solid x\r\n facet normal 0 0 1\r\n  outer loop\r\n   vertex 0 0 0\r\n   vertex 1 0 0\r\n   vertex 0 1 0\r\n  endloop\r\n endfacet\r\n facet normal 0 0 1\r\n  outer loop\r\n   vertex 0 0 0\r\n   vertex 1 0 0\r\n   vertex 0 1 0\r\n  endloop\r\n endfacet\r\nendsolid"[..],
+                "OK tris=[[0, 1, 2], [3, 4, 5]] pos=[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] notes=ReadNotes { skipped_lines: 0, skipped_properties: 0, skipped_primitives: 0, non_utf8_lines: 0, byte_order_mark: false }",
+            ),
+            (
+                Format::Stl,
+                &b"solid x\r\n facet normal 0 0 1\r\n  outer loop\r\n   vertex 0 0 0\r\n   vertex 1 0 0\r\n   vertex 0 1 0\r\n  endloop\r\n endfacet\r\n facet normal 0 0 1\r\n  outer loop\r\n   vertex 0 0 0\r\n   vertex 1 0 0\r\n   vertex 0 1 0\r\n  endloop\r\n endfacet\r\n facet normal 0 0 1\r\n  outer loop\r\n   vertex 0 0 0\r\n   vertex 1 0 0\r\n   vertex 0 1 0.5e"[..],
+                "ERR line 20: facet 2, vertex 2: coordinate 2 is \"0.5e\", not a number",
+            ),
+            (
+                Format::Stl,
+                &b"solid x\r\n facet normal 0 0 1\r\n  outer loop\r\n   vertex 0 0 0\r\n   vertex 1 0 0\r\n   vertex 0 1 0\r\n  endloop\r\n endfacet\r\n facet normal 0 0 1\r\n  outer loop\r\n   vertex 0 0 0\r\n   vertex 1 0 0\r\n   vertex 0 1 0\r\n  endloop\r\n endfacet\r\n facet normal 0 0 1\r\n  outer loop\r\n   vertex 0 0 0\r\n   vertex 1 0 0\r\n   vertex 0 1"[..],
+                "ERR line 20: facet 2, vertex 2: coordinate 2 is \"\", not a number",
+            ),
+            (
+                Format::Stl,
+                &b"solid x\r\n facet normal 0 0 1\r\n  outer loop\r\n   vertex 0 0 0\r\n   vertex 1 0 0\r\n   vertex 0 1 0\r\n  endloop\r\n endfacet\r\n facet normal 0 0 1\r\n  outer loop\r\n   vertex 0 0 0\r\n   vertex 1 0 0\r\n   vertex 0 1 0\r\n  endloop\r\n endfacet\r\n facet normal 0 0 1\r\n  outer loop\r\n   vertex 0 0 0\r\n   vertex 1 0 0\r\n   vertex 0 1 0\r\n  endlo"[..],
+                "ERR line 21: unexpected end of file inside facet 2",
+            ),
+        ];
+        for (format, data, want) in cases {
+            for (how, got) in every_way(data, format) {
+                let got = match got {
+                    Ok(l) => format!(
+                        "OK tris={:?} pos={:?} notes={:?}",
+                        l.mesh.triangles, l.mesh.positions, l.notes
+                    ),
+                    Err(e) => format!("ERR {e}"),
+                };
+                assert_eq!(got, want, "{how}: {data:?}");
+            }
+        }
+    }
+
+    /// ASCII STL whose last line is not UTF-8 and has no line break: that line is
+    /// counted in `non_utf8_lines`, with and without a byte order mark, as the readers
+    /// that parsed all the bytes at once counted it (values from 69c3ccb).
+    #[test]
+    fn an_ascii_stl_last_line_without_a_line_break_is_counted() {
+        let facet = b"facet normal 0 0 1\n outer loop\n  vertex 0 0 0\n  vertex 1 0 0\n  \
+                      vertex 0 1 0\n endloop\nendfacet\n";
+        let facets = facet.repeat(3);
+        let named = [&b"solid caf\xe9\n"[..], &facets, b"endsolid caf\xe9"].concat();
+        let junk = [&b"solid x\n"[..], &facets, b"endsolid x\n\xff\xfe junk"].concat();
+        for (data, non_utf8, skipped) in [(named, 2, 0), (junk, 1, 1)] {
+            for bom in [false, true] {
+                let data = if bom {
+                    [BOM, &data].concat()
+                } else {
+                    data.clone()
+                };
+                for (how, got) in every_way(&data, Format::Stl) {
+                    let got = got.unwrap_or_else(|e| panic!("{how}: {e}"));
+                    assert_eq!(got.mesh.triangles.len(), 3, "{how}");
+                    let notes = &got.notes;
+                    assert_eq!(
+                        (
+                            notes.non_utf8_lines,
+                            notes.skipped_lines,
+                            notes.byte_order_mark
+                        ),
+                        (non_utf8, skipped, bom),
+                        "{how}, bom {bom}"
+                    );
+                }
+            }
         }
     }
 
@@ -664,27 +859,98 @@ mod tests {
         [&data[..at], new, &data[at + old.len()..]].concat()
     }
 
+    /// The inputs that [`cases`] varies (gzipped, twice gzipped, with more after).
+    fn bases() -> Vec<(&'static str, Vec<u8>, Format)> {
+        let ascii =
+            b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+            property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n\
+            0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"
+                .to_vec();
+        let mut bases = vec![
+            ("written", written_ply(), Format::Ply),
+            ("big endian", big_endian_ply(), Format::Ply),
+            ("long header", long_header_ply(), Format::Ply),
+            ("ascii", ascii, Format::Ply),
+            ("stl", written_stl(b"binary"), Format::Stl),
+            ("stl solid", written_stl(b"solid but binary"), Format::Stl),
+        ];
+        bases.extend(text_bases());
+        bases
+    }
+
+    /// Text files whose lines straddle chunks: comments, line ends, a byte order mark,
+    /// bytes that are not UTF-8, no final line break, a line longer than a chunk.
+    fn text_bases() -> Vec<(&'static str, Vec<u8>, Format)> {
+        let long_comment = format!("# {}\n", "long ".repeat(2000));
+        vec![
+            (
+                "off",
+                b"OFF\n# a comment\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n".to_vec(),
+                Format::Off,
+            ),
+            (
+                "coff, bom, crlf, latin-1, no final line break",
+                b"\xEF\xBB\xBFCOFF\r\n# caf\xe9\r\n\r\n4 1 0\r\n0 0 0 255 0 0\r\n1 0 0 0 255 0\r\n\
+                  1 1 0 0 0 255 # blue\r\n0 1 0 9 9 9\r\n4 0 1 2 3 1 0 0\r\nafter \xff\r\nmore"
+                    .to_vec(),
+                Format::Off,
+            ),
+            (
+                "off, counts on their own line, a long comment",
+                format!(
+                    "{long_comment}NOFF\n{long_comment}3 1\n0 0 0 0 0 1\n1 0 0 0 0 1\n\
+                     0 1 0 0 0 1\n{long_comment}3 0 1 2"
+                )
+                .into_bytes(),
+                Format::Off,
+            ),
+            (
+                "ascii ply, bom, crlf, colours, a quad",
+                b"\xEF\xBB\xBFply\r\nformat ascii 1.0\r\ncomment caf\xe9\r\nelement vertex 4\r\n\
+                  property float x\r\nproperty float y\r\nproperty float z\r\n\
+                  property uchar red\r\nproperty uchar green\r\nproperty uchar blue\r\n\
+                  element face 2\r\nproperty list uchar int vertex_indices\r\nend_header\r\n\
+                  0 0 0 255 0 0\r\n1 0 0 0 255 0\r\n1 1 0 0 0 255\r\n0 1 0 9 9 9\r\n\
+                  4 0 1 2 3\r\n3\t0 1\r\n 2"
+                    .to_vec(),
+                Format::Ply,
+            ),
+            (
+                // Cut after "9", the list claims more than the rest holds: that error,
+                // not the index's.
+                "ascii ply, an index out of range",
+                b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+                  property float z\nelement face 1\nproperty list uchar int vertex_indices\n\
+                  end_header\n0 0 0\n1 0 0\n0 1 0\n4 0 1 9 2\n"
+                    .to_vec(),
+                Format::Ply,
+            ),
+            (
+                "ascii stl, bom, crlf, latin-1 names, a quad facet, an unknown word",
+                b"\xEF\xBB\xBFsolid caf\xe9 part\r\n facet normal 0 0 1\r\n  outer loop\r\n\
+                  \x20  vertex 0 0 0\r\n   vertex 1 0 0\r\n   vertex 1 1 0\r\n   vertex 0 1 0\r\n\
+                  \x20 endloop\r\n endfacet\r\n color 1 2 3\r\nendsolid caf\xe9\r\n"
+                    .to_vec(),
+                Format::Stl,
+            ),
+            (
+                "ascii stl, upper case, no final line break",
+                b"SOLID\nFACET NORMAL 0 0 0\nOUTER LOOP\nVERTEX 0 0 0\nVERTEX 1e0 0 0\n\
+                  VERTEX 0 1 -0\nENDLOOP\nENDFACET\nfacet normal 0 0 0 outer loop vertex 0 0 1 \
+                  vertex 1 0 1 vertex 0 1 1 endloop endfacet\nENDSOLID"
+                    .to_vec(),
+                Format::Stl,
+            ),
+        ]
+    }
+
     /// Every input and its variants, named.
     fn cases() -> Vec<(String, Vec<u8>, Format)> {
         let mut cases = Vec::new();
         let ply = written_ply();
         let big = big_endian_ply();
         let stl = written_stl(b"binary");
-        let stl_solid = written_stl(b"solid but binary");
-        let ascii =
-            b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
-            property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n\
-            0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"
-                .to_vec();
-        let bases = [
-            ("written", ply.clone(), Format::Ply),
-            ("big endian", big.clone(), Format::Ply),
-            ("long header", long_header_ply(), Format::Ply),
-            ("ascii", ascii, Format::Ply),
-            ("stl", stl.clone(), Format::Stl),
-            ("stl solid", stl_solid, Format::Stl),
-        ];
-        for (name, data, format) in bases {
+        for (name, data, format) in bases() {
             cases.push((format!("{name} gzipped"), gzip(&data), format));
             cases.push((
                 format!("{name} twice gzipped"),
@@ -802,11 +1068,82 @@ mod tests {
         }
     }
 
+    /// An ASCII PLY list's items are read as they arrive: when one fails, the rest of
+    /// the data decides whether the list claimed more items than it can hold (that
+    /// error, as when the whole data was looked at first) or the item's error stands.
+    #[test]
+    fn an_ascii_list_that_claims_too_much_is_found_when_an_item_fails() {
+        let ply = b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n\
+            property float y\nproperty float z\nelement face 1\n\
+            property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n4 0 1 9 2\n";
+        let cut = ply.len() - 3;
+        let claims = "line 13: unexpected end of file in face 0: its list claims 4 items, \
+                      more than the rest of the file can hold";
+        let index = "line 13: face 0 refers to vertex 9, but there are only 3 vertices";
+        for (data, want) in [(&ply[..], index), (&ply[..cut], claims)] {
+            for chunk in CHUNKS {
+                let got = chunked(data, Format::Ply, chunk, true).map(|_| ());
+                assert_eq!(got.map_err(|e| e.to_string()), Err(want.to_string()));
+            }
+        }
+    }
+
+    /// A text line longer than a chunk is held whole, and only it: the window's buffer
+    /// is written (zero-filled, then read into) up to about the line and a read, not
+    /// to twice the line nor to the file's size (here 2.5 MB, of lines gzip cannot
+    /// shrink past its cap); and when the line is about all the file holds, its
+    /// room is not reserved past the file's end.
+    #[test]
+    fn a_long_line_costs_the_line_not_the_file() {
+        let line = 300_000;
+        let off = |after: &str| {
+            format!(
+                "OFF\n# {}\n3 1\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n{after}",
+                "x".repeat(line)
+            )
+        };
+        let many = (0..200_000)
+            .map(|i| format!("after {i}\n"))
+            .collect::<String>();
+        let data = off(&many);
+        for data in [data.as_bytes().to_vec(), gzip(data.as_bytes())] {
+            let mut input =
+                Input::reader(Box::new(&data[..]), data.len() as u64, 4096).expect("memory reads");
+            let loaded = read_input(&mut input, Format::Off, None).expect("a valid OFF");
+            assert_eq!(loaded.mesh.triangles, vec![[0, 1, 2]]);
+            assert_eq!(loaded.notes.skipped_lines, 200_000);
+            assert!(input.buf.len() > line, "the line is held whole");
+            assert!(input.buf.len() <= line + 3 * 4096, "{}", input.buf.len());
+        }
+        let data = off("");
+        let mut input = Input::reader(Box::new(data.as_bytes()), data.len() as u64, 4096)
+            .expect("memory reads");
+        read_input(&mut input, Format::Off, None).expect("a valid OFF");
+        assert!(
+            input.buf.capacity() <= data.len() + 1,
+            "{}",
+            input.buf.capacity()
+        );
+    }
+
+    /// A plain file smaller than a chunk is read into one buffer of its size in one
+    /// read (after the two bytes that tell gzip), not in reads doubling from
+    /// `FIRST_READ`.
+    #[test]
+    fn a_file_smaller_than_a_chunk_is_read_at_once() {
+        let data = vec![b'x'; 200_000];
+        let mut input =
+            Input::reader(Box::new(&data[..]), data.len() as u64, CHUNK).expect("memory reads");
+        input.fill(3).expect("memory reads");
+        assert_eq!(input.window().len(), data.len());
+        assert_eq!(input.buf.capacity(), data.len());
+    }
+
     /// Every truncation of every input, plain and gzipped, each with one of the chunk
     /// sizes in turn.
     #[test]
     fn every_truncation_gives_what_memory_gives() {
-        for (name, data, format) in cases().into_iter().take(24) {
+        for (name, data, format) in cases().into_iter().take(4 * bases().len()) {
             let step = if data.len() > 10_000 { 97 } else { 1 };
             for cut in (0..data.len()).step_by(step) {
                 let chunk = CHUNKS[cut % CHUNKS.len()];
@@ -821,12 +1158,16 @@ mod tests {
         }
     }
 
-    /// The seed corpus and the regressions of the PLY and STL fuzz targets.
+    /// The seed corpus and the regressions of the fuzz targets of the streamed readers.
     #[test]
     fn fuzz_inputs_give_what_memory_gives() {
         let fuzz = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz");
         let mut seen = 0;
-        for (target, format) in [("read_ply", Format::Ply), ("read_stl", Format::Stl)] {
+        for (target, format) in [
+            ("read_ply", Format::Ply),
+            ("read_stl", Format::Stl),
+            ("read_off", Format::Off),
+        ] {
             for kind in ["corpus", "regressions"] {
                 let Ok(entries) = std::fs::read_dir(fuzz.join(kind).join(target)) else {
                     continue;

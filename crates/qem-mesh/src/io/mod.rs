@@ -9,14 +9,25 @@
 //! function from arbitrary bytes to a mesh or an error: it never panics and never
 //! allocates more than the input can justify.
 //!
-//! **Streaming.** Binary PLY and binary STL are read as they arrive, a chunk at a time
-//! (1 MiB), whole records out of each: reading a file takes about the memory of the
-//! arrays it gives, not the file's (or its decompressed data's) size on top (figures in
-//! BENCHMARKS.md, "Loading"). ASCII PLY and STL, OBJ, OFF and glTF are parsed from all
-//! their (decompressed) bytes at once. Whatever the form, the result and the errors are
-//! those of reading the whole data at once: an error that depends on what comes later
-//! (a cut element, a binary STL's size, a corrupt gzip stream) is given once the rest
-//! has been read.
+//! **Streaming.** PLY (binary and ASCII), STL (binary and ASCII) and OFF are read as
+//! they arrive, a chunk at a time (1 MiB): binary records whole, text a line or a token
+//! at a time, so reading a file takes about the memory of the arrays it gives, not the
+//! file's (or its decompressed data's) size on top (a 4M-triangle sphere: 1.04 times
+//! the arrays as OFF or ASCII PLY, 1.01 as ASCII STL, where it was 2.7 and 3.1 times;
+//! figures in BENCHMARKS.md, "Loading"). A line (or token) longer than a chunk is
+//! held whole while it is read, costing about its length. Parsed from all their
+//! (decompressed) bytes at once: OBJ and glTF; an ASCII STL whose bytes 80..84 (control
+//! bytes there, not text) give a binary STL count of at most `MAX_ELEMENTS` triangles
+//! and a size the data could have, since only its end says whether it is a binary
+//! file; and STL text with more than 4 KiB of whitespace before `solid`. Whatever the
+//! form, the result and the errors are those of reading the whole data at once: an
+//! error that depends on what comes later (a cut element, a binary STL's size, an
+//! ASCII PLY list longer than the rest of the file, a corrupt gzip stream) is given
+//! once the rest has been read. One difference: a plain file's read error in a part
+//! the reader never reaches (after an error in the content, or after a PLY file's
+//! last element) is not seen, so the content's error stands, as it did for binary PLY
+//! and STL (before the text formats streamed, their whole file was read first and its
+//! read error won); gzip data is always read to its end.
 //!
 //! Polygons are fan-triangulated from their first corner. Vertices are never welded
 //! or removed by the PLY, STL and OFF readers (an STL facet gives three new vertices);
@@ -42,8 +53,11 @@
 //! beyond what the remaining bytes could hold (for gzip data, whose size is known only
 //! at its end, beyond what has arrived: the arrays grow as the data arrives); gzip
 //! output is capped at [`GZIP_MAX_RATIO`] times the compressed size and at
-//! [`GZIP_MAX_BYTES`]. A streamed binary PLY record is held whole before it is read, so
-//! a list that claims more than the file holds costs at most the rest of the file.
+//! [`GZIP_MAX_BYTES`]. A streamed binary PLY record, and a text line (or token), is
+//! held whole before it is read: the window's buffer then grows to about that record
+//! or line and one read (not to twice it: room doubles, but only what a read fills is
+//! written), and never past what the rest of the data can hold, so a list that claims
+//! more than the file holds costs at most the rest of the file.
 //!
 //! # Writing
 //! [`write_to`] writes any format to a `Write`; [`write_path`] writes a file
@@ -107,7 +121,7 @@ pub const SUPPORTED_EXTENSIONS: &str =
 /// Decompressed gzip data may be at most this many times the compressed size (plus
 /// 64 KiB, so tiny files are never refused).
 ///
-/// Why 64: the text formats hold the whole decompressed file in memory, and deflate can
+/// Why 64: OBJ and glTF hold the whole decompressed file in memory, and deflate can
 /// expand up to about 1032:1, so a 1 MB "zip bomb" of whitespace would otherwise need
 /// over 2 GB (measured: 2.0 GB peak RSS, see FUZZING.md). Real meshes compress far less: gzip -9
 /// of the project's 49-mesh corpus gives at most 9:1 (OBJ text); 64 leaves a margin of
@@ -324,13 +338,13 @@ fn read_plain(
     if format != Format::Stl {
         notes.byte_order_mark = input.skip_bom()?;
     }
-    // Binary PLY and STL are read as they arrive; the other formats, and ASCII PLY and
-    // STL, are parsed from all their bytes at once.
+    // PLY, STL and OFF are read as they arrive; OBJ (whose reader, tobj, is given the
+    // checked text) and glTF (JSON, and buffers anywhere in it) from all their bytes.
     let mesh = match format {
         Format::Obj => obj::read(&input.rest()?, &mut notes)?,
         Format::Ply => ply::read(input, &mut notes)?,
         Format::Stl => stl::read(input, &mut notes)?,
-        Format::Off => off::read(&input.rest()?, &mut notes)?,
+        Format::Off => off::read(input, &mut notes)?,
         Format::Gltf | Format::Glb => gltf::read(&input.rest()?, format, external, &mut notes)?,
     };
     let loaded = LoadedMesh { mesh, notes };
@@ -596,8 +610,47 @@ pub fn write_path_commented(
     })
 }
 
+/// Bytes of the data's start that [`sniff`] looks at (and, past them, only leading
+/// whitespace).
+pub(crate) const SNIFF_HEAD: usize = 4096;
+
 /// What `bytes` look like, for error messages when they are not the claimed format.
 pub(crate) fn sniff(bytes: &[u8]) -> Option<&'static str> {
+    sniff_start(
+        &bytes[..bytes.len().min(SNIFF_HEAD)],
+        starts_solid(text::trim_start(bytes)),
+    )
+}
+
+/// Whether text starts with `solid` (any case), as ASCII STL does.
+pub(crate) fn starts_solid(text: &[u8]) -> bool {
+    text.get(..5)
+        .is_some_and(|w| w.eq_ignore_ascii_case(b"solid"))
+}
+
+/// [`sniff`] of the data `input` has not consumed yet, for an error found at its
+/// start: whitespace past [`SNIFF_HEAD`] bytes is consumed rather than held.
+pub(crate) fn sniff_input(input: &mut Input<'_>) -> Result<Option<&'static str>, ReadError> {
+    input.fill(SNIFF_HEAD + 5)?;
+    let window = input.window();
+    let head = window[..window.len().min(SNIFF_HEAD)].to_vec();
+    loop {
+        let window = input.window();
+        let text = text::trim_start(window);
+        if text.len() >= 5 || input.at_end() {
+            return Ok(sniff_start(&head, starts_solid(text)));
+        }
+        let (len, blank) = (window.len(), text.is_empty());
+        if blank {
+            input.consume(len);
+        }
+        input.fill(if blank { 5 } else { len + 1 })?;
+    }
+}
+
+/// [`sniff`] from what it needs of the data: its first [`SNIFF_HEAD`] bytes (all of
+/// it when shorter), and whether it starts with `solid` after leading whitespace.
+pub(crate) fn sniff_start(head: &[u8], solid: bool) -> Option<&'static str> {
     const MAGIC: [(&[u8], &str); 7] = [
         (b"\x89PNG", "a PNG image"),
         (b"\xff\xd8\xff", "a JPEG image"),
@@ -607,20 +660,19 @@ pub(crate) fn sniff(bytes: &[u8]) -> Option<&'static str> {
         (b"\x1f\x8b", "gzip data"),
         (b"glTF", "a binary glTF file"),
     ];
-    if let Some((_, what)) = MAGIC.iter().find(|(m, _)| bytes.starts_with(m)) {
+    if let Some((_, what)) = MAGIC.iter().find(|(m, _)| head.starts_with(m)) {
         return Some(what);
     }
-    if bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n") {
+    if ply::starts_ply(head) {
         return Some("a PLY file");
     }
-    let head = &bytes[..bytes.len().min(4096)];
+    let head = &head[..head.len().min(SNIFF_HEAD)];
     let first = text::first_content_line(head, b'#');
     let word = first.split(|b| b.is_ascii_whitespace()).next()?;
     if word.len() >= 3 && word.ends_with(b"OFF") && word.iter().all(u8::is_ascii_alphanumeric) {
         return Some("an OFF file");
     }
-    let trimmed = text::trim_start(bytes);
-    if trimmed.len() >= 5 && trimmed[..5].eq_ignore_ascii_case(b"solid") {
+    if solid {
         return Some("an ASCII STL file");
     }
     if head.iter().all(|&b| b >= 0x20 || b.is_ascii_whitespace())

@@ -44,27 +44,39 @@ use std::io::Write;
 use smallvec::SmallVec;
 
 use super::channels::{colours_on_faces, per_vertex, unit_colours};
-use super::text::{self, capacity_for, parse_f32, parse_f64, parse_i64, show, words};
-use super::{sniff, Format, Location, ReadError, ReadNotes};
+use super::input::Input;
+use super::text::{self, capacity_for, parse_f32, parse_f64, parse_i64, show, words, TextStream};
+use super::{sniff_start, starts_solid, Format, Location, ReadError, ReadNotes, SNIFF_HEAD};
 use crate::attributes::{Attributes, Channel, ChannelKind};
 use crate::{IndexedMesh, InputError, MAX_ELEMENTS};
 
-pub(crate) fn read(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, ReadError> {
-    let mut lines = text::lines(bytes)
-        .map(|(no, l)| (no, text::trim(text::strip_comment(l, b'#'))))
-        .filter(|(_, l)| !l.is_empty());
-    let not_off =
-        |detail: &str| ReadError::not_this_format(Format::Off, sniff(bytes), detail.to_string());
-    let Some((header_line, header)) = lines.next() else {
-        return Err(not_off("no header (only blank lines and comments)"));
+/// Reads an OFF file a line at a time as it arrives.
+pub(crate) fn read(input: &mut Input<'_>, notes: &mut ReadNotes) -> Result<IndexedMesh, ReadError> {
+    // What `sniff` needs to say what data that is not OFF looks like: its start, and
+    // whether its first line with content starts with "solid" (`next_content` notes it).
+    input.fill(SNIFF_HEAD)?;
+    let window = input.window();
+    let head = window[..window.len().min(SNIFF_HEAD)].to_vec();
+    let mut solid = None;
+    let mut lines = TextStream::new(input, 1);
+    lines.count_non_utf8();
+    let not_off = |detail: &str, solid: Option<bool>| {
+        ReadError::not_this_format(
+            Format::Off,
+            sniff_start(&head, solid == Some(true)),
+            detail.to_string(),
+        )
+    };
+    let Some((header_line, header)) = next_content(&mut lines, &mut solid)? else {
+        return Err(not_off("no header (only blank lines and comments)", solid));
     };
     let mut header_words = words(header);
     let magic = header_words.next().unwrap_or_default();
     let Some(prefix) = magic.strip_suffix(b"OFF") else {
-        return Err(not_off(&format!(
-            "the first word is {}, not OFF",
-            show(magic)
-        )));
+        return Err(not_off(
+            &format!("the first word is {}, not OFF", show(magic)),
+            solid,
+        ));
     };
     let at = |line| Location::Line(line);
     // The spec's order is ST, C, N; N before C is accepted too (some writers use it).
@@ -84,25 +96,29 @@ pub(crate) fn read(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, R
             ))
         }
     };
-    let mut counts: Vec<&[u8]> = header_words.collect();
-    if counts.first() == Some(&&b"BINARY"[..]) {
+    // The counts are copied, so the header's line can be let go.
+    let mut counts: SmallVec<[Vec<u8>; 2]> =
+        header_words.by_ref().take(2).map(<[u8]>::to_vec).collect();
+    let mut count_words = counts.len() + header_words.count();
+    if counts.first().is_some_and(|w| w == b"BINARY") {
         return Err(ReadError::malformed(
             at(header_line),
             "binary OFF is not supported",
         ));
     }
     let mut counts_line = header_line;
-    if counts.is_empty() {
-        let Some((no, l)) = lines.next() else {
+    if count_words == 0 {
+        let Some((no, l)) = next_content(&mut lines, &mut solid)? else {
             return Err(ReadError::truncated(
                 at(header_line),
                 "after the header: no vertex and face counts",
             ));
         };
         counts_line = no;
-        counts = words(l).collect();
+        counts = words(l).take(2).map(<[u8]>::to_vec).collect();
+        count_words = words(l).count();
     }
-    if counts.len() < 2 {
+    if count_words < 2 {
         return Err(ReadError::malformed(
             at(counts_line),
             "expected vertex, face and edge counts",
@@ -121,10 +137,10 @@ pub(crate) fn read(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, R
         }
         Ok(n as usize)
     };
-    let nv = parse_count(counts[0], "vertex", "vertices")?;
-    let nf = parse_count(counts[1], "face", "faces")?;
+    let nv = parse_count(&counts[0], "vertex", "vertices")?;
+    let nf = parse_count(&counts[1], "face", "faces")?;
 
-    let mut positions = Vec::with_capacity(capacity_for(nv, bytes.len(), 6));
+    let mut positions = Vec::with_capacity(capacity_for(nv, lines.could_hold(), 6));
     let mut normals = Vec::new();
     let mut colours = Vec::new();
     let mut uvs = Vec::new();
@@ -143,7 +159,7 @@ pub(crate) fn read(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, R
     let mut colour_dimension = None;
     let mut last_line = counts_line;
     for v in 0..nv {
-        let Some((no, l)) = lines.next() else {
+        let Some((no, l)) = next_content(&mut lines, &mut solid)? else {
             return Err(ReadError::truncated(
                 at(last_line),
                 format!("after {v} of {nv} vertices"),
@@ -221,14 +237,14 @@ pub(crate) fn read(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, R
             }
         }
     }
-    let mut triangles = Vec::with_capacity(capacity_for(nf, bytes.len(), 8));
+    let mut triangles = Vec::with_capacity(capacity_for(nf, lines.could_hold(), 8));
     let mut corners: Vec<u32> = Vec::new();
     let mut face_colours: Vec<f32> = Vec::new();
     let mut face_dimension = None;
     // Per triangle, its face colour's index (filled from the first coloured face on).
     let mut triangle_colours: Vec<u32> = Vec::new();
     for f in 0..nf {
-        let Some((no, l)) = lines.next() else {
+        let Some((no, l)) = next_content(&mut lines, &mut solid)? else {
             return Err(ReadError::truncated(
                 at(last_line),
                 format!("after {f} of {nf} faces"),
@@ -300,8 +316,10 @@ pub(crate) fn read(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, R
             triangle_colours.resize(triangles.len(), index);
         }
     }
-    notes.skipped_lines += lines.count();
-    notes.non_utf8_lines += text::non_utf8_lines(bytes);
+    while next_content(&mut lines, &mut solid)?.is_some() {
+        notes.skipped_lines += 1;
+    }
+    notes.non_utf8_lines += lines.non_utf8_lines();
     let mut channels = Vec::new();
     let per_vertex = |kind, values| Channel::new(kind, values, triangles.clone());
     if has_normal {
@@ -333,6 +351,30 @@ pub(crate) fn read(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, R
             ..Attributes::default()
         }),
     )
+}
+
+/// The next line with content once its comment is cut off, trimmed, with its number.
+/// Notes in `solid`, at the first line with anything but whitespace (comments
+/// included), whether it starts with "solid" (what [`sniff`](super::sniff) looks for
+/// past the data's start).
+fn next_content<'s>(
+    lines: &'s mut TextStream<'_, '_>,
+    solid: &mut Option<bool>,
+) -> Result<Option<(usize, &'s [u8])>, ReadError> {
+    loop {
+        let Some((no, span)) = lines.next_line_span()? else {
+            return Ok(None);
+        };
+        let raw = lines.span(span.clone());
+        if solid.is_none() && !text::trim(raw).is_empty() {
+            *solid = Some(starts_solid(text::trim_start(raw)));
+        }
+        let content = text::trimmed(text::strip_comment(raw, b'#'));
+        if !content.is_empty() {
+            let at = span.start;
+            return Ok(Some((no, lines.span(at + content.start..at + content.end))));
+        }
+    }
 }
 
 /// One attribute number of an OFF line (`what` of `item`), as the nearest `f32`.

@@ -58,8 +58,8 @@ use std::io::Write;
 use super::channels::{all_levels, colours_on_faces, from_level, per_vertex, to_level};
 use super::input::Input;
 use super::off::fan;
-use super::text::{self, capacity_for, parse_f32, parse_f64, parse_i64, show, Tokens};
-use super::{sniff, Format, Location, ReadError, ReadErrorKind, ReadNotes};
+use super::text::{self, capacity_for, parse_f32, parse_f64, parse_i64, show, TextStream};
+use super::{sniff, sniff_input, Format, Location, ReadError, ReadErrorKind, ReadNotes};
 use crate::attributes::{Attributes, Channel, ChannelKind};
 use crate::{IndexedMesh, InputError, MAX_ELEMENTS};
 
@@ -134,13 +134,14 @@ struct Header<'a> {
     body_line: usize,
 }
 
+/// Whether `bytes` start with PLY's magic line (`ply` and a line break).
+pub(crate) fn starts_ply(bytes: &[u8]) -> bool {
+    bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n")
+}
+
 fn parse_header<'a>(bytes: &'a [u8], notes: &mut ReadNotes) -> Result<Header<'a>, ReadError> {
-    if !(bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n")) {
-        return Err(ReadError::not_this_format(
-            Format::Ply,
-            sniff(bytes),
-            "does not start with \"ply\"",
-        ));
+    if !starts_ply(bytes) {
+        return Err(not_ply(sniff(bytes)));
     }
     let mut encoding = None;
     let mut elements: Vec<Element> = Vec::new();
@@ -705,17 +706,21 @@ impl Builder {
 /// steps.
 pub(crate) const HEADER_PREFIX: usize = 1 << 16;
 
-/// Reads a PLY file. A binary body is read as it arrives, whole records at a time;
-/// an ASCII one (and data that is not a PLY header) is parsed from all its bytes at
-/// once.
+/// Reads a PLY file as it arrives: the header whole, then a binary body whole records
+/// at a time, an ASCII one a token at a time.
 pub(crate) fn read(input: &mut Input<'_>, notes: &mut ReadNotes) -> Result<IndexedMesh, ReadError> {
+    input.fill(b"ply\r\n".len())?;
+    if !starts_ply(input.window()) {
+        return Err(not_ply(sniff_input(input)?));
+    }
     let mut want = HEADER_PREFIX;
     loop {
         input.fill(want)?;
         let window = input.window();
         let end = input.at_end();
         // The window's lines are whole up to its last line break, or all of it at the
-        // end of the data: a header found in them is the whole data's header.
+        // end of the data: a header found in them is the whole data's header, and an
+        // error in them is the whole data's first error.
         let cut = if end {
             Some(window.len())
         } else {
@@ -733,42 +738,30 @@ pub(crate) fn read(input: &mut Input<'_>, notes: &mut ReadNotes) -> Result<Index
                 Some(Ok(_)) => false,
             };
         match tried {
-            Some(Ok((Encoding::Little | Encoding::Big, body))) => {
+            Some(Ok((encoding, body))) => {
                 let head = window[..body].to_vec();
                 input.consume(body);
                 let header = parse_header(&head, notes)?;
-                return read_body(&head, &header, Body::Binary(input), notes);
+                let body = match encoding {
+                    Encoding::Ascii => Body::Ascii(TextStream::new(input, header.body_line)),
+                    Encoding::Little | Encoding::Big => Body::Binary(input),
+                };
+                return read_body(&head, &header, body, notes);
             }
-            _ if goes_on => want = window.len().saturating_mul(2),
-            // ASCII, or not a PLY header: decided on all the bytes.
-            _ => break,
+            Some(Err(e)) if !goes_on => return Err(e),
+            _ => want = window.len().saturating_mul(2),
         }
     }
-    read_all(&input.rest()?, notes)
 }
 
-/// Reads a PLY file from all its bytes.
-fn read_all(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, ReadError> {
-    let header = parse_header(bytes, notes)?;
-    let head = bytes.get(..header.body).unwrap_or_default();
-    let body = bytes.get(header.body..).unwrap_or_default();
-    let body = match header.encoding {
-        Encoding::Ascii => Body::Ascii(Tokens::new(body, header.body_line)),
-        Encoding::Little | Encoding::Big => {
-            return read_body(
-                head,
-                &header,
-                Body::Binary(&mut Input::plain_at(body, header.body as u64)),
-                notes,
-            )
-        }
-    };
-    read_body(head, &header, body, notes)
+/// The error for data that does not start with a PLY header's first line.
+fn not_ply(looks_like: Option<&'static str>) -> ReadError {
+    ReadError::not_this_format(Format::Ply, looks_like, "does not start with \"ply\"")
 }
 
 /// Where the elements' records come from.
-enum Body<'t, 'i, 'a> {
-    Ascii(Tokens<'t>),
+enum Body<'i, 'a> {
+    Ascii(TextStream<'i, 'a>),
     Binary(&'i mut Input<'a>),
 }
 
@@ -895,7 +888,7 @@ struct Reading<'e, 'a> {
 }
 
 fn read_ascii_element(
-    tok: &mut Tokens<'_>,
+    tok: &mut TextStream<'_, '_>,
     reading: &Reading,
     b: &mut Builder,
 ) -> Result<(), ReadError> {
@@ -904,11 +897,11 @@ fn read_ascii_element(
     let is_face = roles.iter().any(|r| matches!(r, Role::Indices));
     if is_vertex {
         b.positions
-            .reserve(capacity_for(el.count, tok.remaining(), 6));
+            .reserve(capacity_for(el.count, tok.could_hold(), 6));
     }
     if is_face {
         b.triangles
-            .reserve(capacity_for(el.count, tok.remaining(), 8));
+            .reserve(capacity_for(el.count, tok.could_hold(), 8));
     }
     let what = plural(el.name);
     for r in 0..el.count {
@@ -917,10 +910,10 @@ fn read_ascii_element(
         for (&(name, prop), &role) in el.props.iter().zip(roles) {
             match (prop, role) {
                 (Prop::Scalar(_), Role::Coord(k)) => {
-                    let t = next_token(tok, r, el.count, &what)?;
+                    let (t, line) = next_token(tok, r, el.count, &what)?;
                     p[k] = parse_f64(t).ok_or_else(|| {
                         ReadError::malformed(
-                            Location::Line(tok.line()),
+                            Location::Line(line),
                             format!("vertex {r}: bad coordinate {}", show(t)),
                         )
                     })?;
@@ -933,8 +926,8 @@ fn read_ascii_element(
                         convert,
                     },
                 ) => {
-                    let t = next_token(tok, r, el.count, &what)?;
-                    let at = Location::Line(tok.line());
+                    let (t, line) = next_token(tok, r, el.count, &what)?;
+                    let at = Location::Line(line);
                     let value = match convert {
                         Convert::Float => parse_f32(t),
                         Convert::Level(max) => parse_f64(t).map(|v| from_level(v, max)),
@@ -963,8 +956,8 @@ fn read_ascii_element(
                     next_token(tok, r, el.count, &what)?;
                 }
                 (Prop::List(..), role) => {
-                    let t = next_token(tok, r, el.count, &what)?;
-                    let line = Location::Line(tok.line());
+                    let (t, line) = next_token(tok, r, el.count, &what)?;
+                    let line = Location::Line(line);
                     let n = parse_i64(t).filter(|&n| n >= 0).ok_or_else(|| {
                         ReadError::malformed(
                             line,
@@ -976,21 +969,11 @@ fn read_ascii_element(
                             ),
                         )
                     })?;
-                    // Every item needs at least two bytes ("0 ").
-                    if n as u64 > (tok.remaining() as u64).div_ceil(2) {
-                        return Err(ReadError::truncated(
-                            line,
-                            format!(
-                                "in {} {r}: its list claims {n} items, more than the rest \
-                                 of the file can hold",
-                                el.name.escape_ascii()
-                            ),
-                        ));
-                    }
-                    for _ in 0..n {
-                        let t = next_token(tok, r, el.count, &what)?;
+                    let start = tok.offset();
+                    let items = (0..n).try_for_each(|_| {
+                        let (t, line) = next_token(tok, r, el.count, &what)?;
                         if let Role::Indices = role {
-                            let at = Location::Line(tok.line());
+                            let at = Location::Line(line);
                             let i = parse_i64(t).ok_or_else(|| {
                                 ReadError::malformed(
                                     at,
@@ -999,6 +982,26 @@ fn read_ascii_element(
                             })?;
                             b.push_index(i, at)?;
                         }
+                        Ok(())
+                    });
+                    if let Err(e) = items {
+                        // A list that claims more items than the rest of the data can
+                        // hold (each needs at least two bytes, "0 ") is that error
+                        // rather than one of its items'. Its items are read as they
+                        // arrive, so the rest is measured only when one fails: a list
+                        // whose items all are there cannot claim too many.
+                        let rest = tok.offset() + tok.count_rest()? - start;
+                        if n as u64 > rest.div_ceil(2) {
+                            return Err(ReadError::truncated(
+                                line,
+                                format!(
+                                    "in {} {r}: its list claims {n} items, more than the rest \
+                                     of the file can hold",
+                                    el.name.escape_ascii()
+                                ),
+                            ));
+                        }
+                        return Err(e);
                     }
                     if let Role::Indices = role {
                         b.end_face(line)?;
@@ -1013,15 +1016,16 @@ fn read_ascii_element(
     Ok(())
 }
 
-/// The next ascii token, or a truncation error naming how many records were complete.
-fn next_token<'a>(
-    tok: &mut Tokens<'a>,
+/// The next ascii token and its line, or a truncation error naming how many records
+/// were complete.
+fn next_token<'t>(
+    tok: &'t mut TextStream<'_, '_>,
     done: usize,
     count: usize,
     what: &str,
-) -> Result<&'a [u8], ReadError> {
+) -> Result<(&'t [u8], usize), ReadError> {
     let line = tok.line();
-    tok.next_token().ok_or_else(|| {
+    tok.next_token()?.ok_or_else(|| {
         ReadError::truncated(
             Location::Line(line),
             format!("after {done} of {count} {what}"),

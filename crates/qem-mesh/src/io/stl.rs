@@ -15,31 +15,62 @@
 use std::io::Write;
 
 use super::input::Input;
-use super::text::{self, capacity_for, parse_f64, show, Tokens};
-use super::{sniff, strip_bom, Format, Location, ReadError, ReadNotes};
+use super::text::{self, capacity_for, parse_f64, show, TextStream};
+use super::{sniff, strip_bom, Format, Location, ReadError, ReadNotes, BOM, SNIFF_HEAD};
 use crate::{IndexedMesh, InputError, MAX_ELEMENTS};
 
 const HEADER: usize = 84;
 const RECORD: usize = 50;
 
 /// What the start of the data must hold for [`sniff`] and the NUL test below to see
-/// what they would see in the whole data: a byte order mark and 4096 bytes.
-const START: usize = 3 + 4096;
+/// what they would see in the whole data: a byte order mark and what `sniff` looks at.
+const START: usize = BOM.len() + SNIFF_HEAD;
 
-/// Reads an STL file: binary STL as it arrives, ASCII STL from all its bytes at once.
+/// Reads an STL file as it arrives: binary STL whole records at a time, ASCII STL a
+/// token at a time.
 pub(crate) fn read(input: &mut Input<'_>, notes: &mut ReadNotes) -> Result<IndexedMesh, ReadError> {
     input.fill(START)?;
     let window = input.window();
-    let (text, _) = strip_bom(window);
-    // `sniff` looks past the first 4096 bytes only to skip leading whitespace.
+    let (text, bom) = strip_bom(window);
+    // `sniff` looks past its first `SNIFF_HEAD` bytes only to skip leading whitespace.
     let decided = input.at_end() || text::trim_start(text).len() >= 5;
     let count = window
         .get(80..84)
         .and_then(|b| b.try_into().ok())
         .map(u32::from_le_bytes);
     let looks_like = sniff(text);
+    let ascii = decided && is_text(looks_like, text);
     match count {
-        Some(n) if decided && !is_text(looks_like, text) => read_binary(input, n, looks_like),
+        Some(n) if decided && !ascii => read_binary(input, n, looks_like),
+        // Text is binary STL all the same if its size is that of a binary file of the
+        // count at byte 80, which only the end of the data tells. Read as it arrives
+        // when the data cannot be that big (`could_hold` is at least its size); a
+        // count beyond `MAX_ELEMENTS` gives the same error whichever way it is read.
+        Some(n)
+            if ascii
+                && (n as usize > MAX_ELEMENTS || expected_len(n) > input.could_hold() as u64) =>
+        {
+            // Only a count beyond `MAX_ELEMENTS` can leave the size in doubt here: the
+            // rest is read to its end for that one case, not for every error.
+            let maybe_binary =
+                n as usize > MAX_ELEMENTS && expected_len(n) <= input.could_hold() as u64;
+            notes.byte_order_mark = bom;
+            // Unlike `skip_bom`, offsets keep counting the mark: the size compared is
+            // the whole data's.
+            input.consume(if bom { BOM.len() } else { 0 });
+            let mut tok = TextStream::new(input, 1);
+            tok.count_non_utf8();
+            let read = read_ascii(&mut tok, notes);
+            // Counted before `count_rest`, which skips what is left without counting
+            // it (a last line without a line break went uncounted that way).
+            let non_utf8 = tok.non_utf8_lines();
+            if maybe_binary && tok.offset() + tok.count_rest()? == expected_len(n) {
+                return Err(too_many_binary(n));
+            }
+            let mesh = read?;
+            notes.non_utf8_lines += non_utf8;
+            Ok(mesh)
+        }
         _ => read_all(&input.rest()?, notes),
     }
 }
@@ -64,11 +95,24 @@ fn read_all(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, ReadErro
         }
         _ if is_text(looks_like, text) => {
             notes.byte_order_mark = bom;
-            notes.non_utf8_lines += super::text::non_utf8_lines(text);
-            read_ascii(text, notes)
+            let mut input = Input::plain(text);
+            let mut tok = TextStream::new(&mut input, 1);
+            tok.count_non_utf8();
+            let mesh = read_ascii(&mut tok, notes)?;
+            notes.non_utf8_lines += tok.non_utf8_lines();
+            Ok(mesh)
         }
         _ => Err(not_stl(looks_like)),
     }
+}
+
+/// The error for a binary STL header's count `n` beyond [`MAX_ELEMENTS`].
+fn too_many_binary(n: u32) -> ReadError {
+    ReadError::too_large(
+        Location::Byte(80),
+        "binary STL header claims triangles:",
+        n as u64,
+    )
 }
 
 /// The size of a binary STL file of `n` triangles.
@@ -130,11 +174,7 @@ fn read_binary(
         None | Some("an ASCII STL file") | Some("binary data")
     );
     if too_large && (binary_error || len == expected_len(n)) {
-        return Err(ReadError::too_large(
-            Location::Byte(80),
-            "binary STL header claims triangles:",
-            n as u64,
-        ));
+        return Err(too_many_binary(n));
     }
     if !binary_error {
         return Err(not_stl(looks_like));
@@ -197,8 +237,49 @@ fn read_facets(
     None
 }
 
-fn read_ascii(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, ReadError> {
-    let mut tok = Tokens::new(bytes, 1);
+/// The words of ASCII STL's grammar, and the others.
+#[derive(Clone, Copy, PartialEq)]
+enum Word {
+    /// `solid` or `endsolid`, followed by a free-form name.
+    Solid,
+    Facet,
+    Vertex,
+    EndFacet,
+    /// `normal`, `outer`, `loop`, `endloop` and numbers: nothing the reader keeps.
+    Passed,
+    /// Not STL: an exporter's extension or junk.
+    Other,
+}
+
+impl Word {
+    fn of(word: &[u8]) -> Word {
+        let is = |kw: &[u8]| word.eq_ignore_ascii_case(kw);
+        if is(b"solid") || is(b"endsolid") {
+            Word::Solid
+        } else if is(b"facet") {
+            Word::Facet
+        } else if is(b"vertex") {
+            Word::Vertex
+        } else if is(b"endfacet") {
+            Word::EndFacet
+        } else if is(b"normal")
+            || is(b"outer")
+            || is(b"loop")
+            || is(b"endloop")
+            || parse_f64(word).is_some()
+        {
+            Word::Passed
+        } else {
+            Word::Other
+        }
+    }
+}
+
+/// Reads ASCII STL from `tok` (at the start of the text, after a byte order mark).
+fn read_ascii(
+    tok: &mut TextStream<'_, '_>,
+    notes: &mut ReadNotes,
+) -> Result<IndexedMesh, ReadError> {
     // The last line counted in `notes.skipped_lines`, so a line is counted once.
     let mut skipped_line = 0usize;
     let mut positions: Vec<[f64; 3]> = Vec::new();
@@ -206,14 +287,13 @@ fn read_ascii(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, ReadEr
     // Index in `positions` of the current facet's first vertex, while inside a facet.
     let mut facet_start: Option<usize> = None;
     let mut facets = 0usize;
-    while let Some(word) = tok.next_token() {
-        let line = tok.line();
+    while let Some((word, line)) = tok.next_token()? {
         let at = Location::Line(line);
-        let is = |kw: &[u8]| word.eq_ignore_ascii_case(kw);
-        if is(b"solid") || is(b"endsolid") {
+        let word = Word::of(word);
+        if word == Word::Solid {
             // The rest of the line is a free-form name.
-            tok.skip_line();
-        } else if is(b"facet") {
+            tok.skip_line()?;
+        } else if word == Word::Facet {
             if facet_start.is_some() {
                 return Err(ReadError::malformed(
                     at,
@@ -221,7 +301,7 @@ fn read_ascii(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, ReadEr
                 ));
             }
             facet_start = Some(positions.len());
-        } else if is(b"vertex") {
+        } else if word == Word::Vertex {
             let Some(start) = facet_start else {
                 return Err(ReadError::malformed(
                     at,
@@ -230,10 +310,13 @@ fn read_ascii(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, ReadEr
             };
             let mut p = [0.0; 3];
             for (k, c) in p.iter_mut().enumerate() {
-                let t = tok.next_token().unwrap_or_default();
+                let (t, line) = match tok.next_token()? {
+                    Some(token) => token,
+                    None => (&[][..], tok.line()),
+                };
                 *c = parse_f64(t).ok_or_else(|| {
                     ReadError::malformed(
-                        Location::Line(tok.line()),
+                        Location::Line(line),
                         format!(
                             "facet {facets}, vertex {}: coordinate {k} is {}, not a number",
                             positions.len() - start,
@@ -258,7 +341,7 @@ fn read_ascii(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, ReadEr
                 ));
             }
             positions.push(p);
-        } else if is(b"endfacet") {
+        } else if word == Word::EndFacet {
             let Some(start) = facet_start.take() else {
                 return Err(ReadError::malformed(at, "\"endfacet\" without \"facet\""));
             };
@@ -274,11 +357,8 @@ fn read_ascii(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, ReadEr
                 triangles.push([a, k as u32, k as u32 + 1]);
             }
             facets += 1;
-        } else if !(is(b"normal") || is(b"outer") || is(b"loop") || is(b"endloop"))
-            && parse_f64(word).is_none()
-            && skipped_line != line
-        {
-            // Not STL: an exporter's extension or junk. It has no say in the geometry.
+        } else if word == Word::Other && skipped_line != line {
+            // An exporter's extension or junk: it has no say in the geometry.
             notes.skipped_lines += 1;
             skipped_line = line;
         }
