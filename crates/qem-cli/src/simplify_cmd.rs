@@ -292,3 +292,39 @@ fn file_name(p: &Path) -> String {
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| p.display().to_string())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use qem_mesh::simplify::Phase;
+
+    /// Asks to stop as soon as the cleaning ends, as Ctrl-C pressed then would.
+    struct StopAfterCleaning(bool);
+
+    impl Observer for StopAfterCleaning {
+        fn phase(&mut self, phase: Phase) {
+            self.0 |= phase == Phase::Cleaning;
+        }
+        fn should_stop(&mut self) -> bool {
+            self.0
+        }
+    }
+
+    /// A stop before the loop is an interruption (exit 130), not an error naming the
+    /// file, and no output is written.
+    #[test]
+    fn a_stop_before_the_loop_is_an_interruption_and_writes_nothing() {
+        let dir = tempfile::tempdir().expect("a temporary directory");
+        let input = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/spot.obj");
+        let output = dir.path().join("out.ply");
+        let result = simplify_file(
+            &input,
+            &output,
+            &SimplifyOptions::DEFAULT,
+            &mut StopAfterCleaning(false),
+            false,
+        );
+        assert!(matches!(result, Err(Failure::Interrupted)), "{result:?}");
+        assert!(!output.exists());
+    }
+}
