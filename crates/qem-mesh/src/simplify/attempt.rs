@@ -54,7 +54,7 @@ impl Engine {
         let attempt = if removed >= live {
             self.counters.reject(Rejection::LastTriangles);
             Attempt::Refused
-        } else if misses_target(live - removed, target) && !self.ladder.may_pass_target {
+        } else if misses_target(live - removed, target, self.ladder.may_pass_by) {
             // Put off while a pair that removes fewer may land on the target (not a
             // check's refusal: it is tried again once none does).
             self.ladder.put_off_past_target = true;
@@ -65,7 +65,13 @@ impl Engine {
                 shared,
                 merged: &merged,
             };
-            self.check_and_contract(a, b, star, speculation, observer)
+            let attempt = self.check_and_contract(a, b, star, speculation, observer);
+            match attempt {
+                Attempt::Contracted { .. } => self.ladder.refused_since_contraction = false,
+                Attempt::Refused | Attempt::Waived => self.ladder.refused_since_contraction = true,
+                Attempt::OverErrorBound | Attempt::NotAPair => {}
+            }
+            attempt
         };
         self.around = around;
         attempt
@@ -442,9 +448,11 @@ pub(super) enum Attempt {
 const TARGET_TOLERANCE: f64 = 0.01;
 
 /// Whether ending at `count` triangles misses `target` from below by more than
-/// [`TARGET_TOLERANCE`].
-pub(super) fn misses_target(count: usize, target: usize) -> bool {
-    count < target && (target - count) as f64 > target as f64 * TARGET_TOLERANCE
+/// [`TARGET_TOLERANCE`] and more than `allowed` triangles.
+pub(super) fn misses_target(count: usize, target: usize, allowed: usize) -> bool {
+    count < target
+        && (target - count) as f64 > target as f64 * TARGET_TOLERANCE
+        && target - count > allowed
 }
 
 /// The positions of a triangle's `corners` once the pair `ends` is contracted to

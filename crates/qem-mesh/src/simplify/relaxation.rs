@@ -137,13 +137,19 @@ pub(super) struct Ladder {
     pub contractions: [Option<usize>; RelaxationStep::ALL.len()],
     /// What stopped the last run that stopped with no pair left.
     pub stopped_by: Option<Constraint>,
-    /// Whether a contraction may take the count below the target (see
-    /// [`Engine::run_landing`](super::engine::Engine::run_landing)); set for each
-    /// level once no pair lands on it.
-    pub may_pass_target: bool,
+    /// How many triangles below the target a contraction may take the count, beyond
+    /// the 1% that always counts as reaching it (see
+    /// [`Engine::run_landing`](super::engine::Engine::run_landing)): 0 until no pair
+    /// lands on the level's target, then grown until a pair passes it.
+    pub may_pass_by: usize,
     /// Whether an attempt was put off because it would have taken the count below
     /// the target while that was not allowed.
     pub put_off_past_target: bool,
+    /// Whether a check refused a pair since the last contraction: when a run stops
+    /// with pairs put off, a relaxed check may then let a pair land on the target
+    /// (none may when every pair left was put off, e.g. a closed mesh one triangle
+    /// above an odd target).
+    pub refused_since_contraction: bool,
 }
 
 impl Ladder {

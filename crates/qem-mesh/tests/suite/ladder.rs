@@ -449,3 +449,59 @@ fn a_put_off_pair_within_the_error_bound_is_taken_when_landing_is_over_it() {
         assert_eq!(out.mesh.triangle_count(), 40, "{order:?}");
     }
 }
+
+/// A UV sphere with one triangle taken out: 63 triangles around a three-edge hole.
+fn holed_sphere() -> IndexedMesh {
+    let mut mesh = uv_sphere([0.0; 3], 1.0, 5, 8);
+    mesh.triangles.remove(20);
+    mesh
+}
+
+/// A run whose last step to a small target is refused by a check (here only a
+/// contraction that closes the hole removes one triangle, and closing a border loop is
+/// a relaxation) climbs the ladder to land on it rather than passing it; `strict`
+/// passes it, as every run did before the landing climbed.
+#[test]
+fn a_run_climbs_the_ladder_to_land_on_a_small_target() {
+    let mesh = holed_sphere();
+    for order in ORDERS {
+        for target in [40, 20, 10] {
+            let out = simplify_replayed(&mesh, &options(order, Target::Triangles(target)))
+                .expect("simplifies");
+            assert_valid(&out.mesh, 63);
+            assert_eq!(out.mesh.triangle_count(), target, "{order:?}");
+            assert_eq!(out.report.stop_reason, StopReason::TargetReached);
+            assert!(
+                out.report
+                    .relaxations
+                    .iter()
+                    .any(|r| r.step == RelaxationStep::BorderLoops && r.contractions > 0),
+                "{order:?} {target}: {:?}",
+                out.report.relaxations
+            );
+            let strict = simplify(
+                &mesh,
+                &options(order, Target::Triangles(target)).with_strict(true),
+            )
+            .expect("simplifies");
+            assert_eq!(strict.mesh.triangle_count(), target - 1, "{order:?}");
+        }
+    }
+}
+
+/// When no pair lands on the target, the pair put off that passes it by the fewest
+/// triangles goes: beside the tetrahedra (whose last contractions merge faces and
+/// remove four), a grid's inner edge ends one below the target, not three.
+#[test]
+fn a_target_no_pair_lands_on_is_passed_by_the_fewest_triangles() {
+    let mesh = concat(&[grid(5, 5, 0.8), tetrahedra(3)]);
+    for order in ORDERS {
+        for target in [9, 5] {
+            let out = simplify_replayed(&mesh, &options(order, Target::Triangles(target)))
+                .expect("simplifies");
+            assert_valid(&out.mesh, mesh.triangle_count());
+            assert_eq!(out.mesh.triangle_count(), target - 1, "{order:?}");
+            assert_eq!(out.report.stop_reason, StopReason::TargetReached);
+        }
+    }
+}
