@@ -72,9 +72,10 @@ pub struct SimplifyFlags {
     #[arg(long, value_enum, default_value_t = VirtualPairsFlag::Any)]
     pub virtual_pairs: VirtualPairsFlag,
     /// Weight of the constraint planes through border edges (perpendicular to the
-    /// border's face), relative to the faces' own planes; 0 lets borders move freely
-    /// and turns the loop rule off (above 0, border loops are never pinched or closed
-    /// unless the run is stuck: see --strict).
+    /// border's face), relative to the faces' own planes; 0 lets borders move freely,
+    /// turns the loop rule off and drops the seams' planes (above 0, border loops are
+    /// never pinched or closed unless the run is stuck: see --strict; seams keep
+    /// planes of weight 1).
     #[arg(long, default_value_t = DEFAULT_BOUNDARY_WEIGHT, value_parser = parse_non_negative,
           conflicts_with = "lock_boundary")]
     pub boundary_weight: f64,

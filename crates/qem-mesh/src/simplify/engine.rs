@@ -27,7 +27,7 @@ use super::nth_key::nth_key;
 use super::observer::{Contraction, Observer, Progress};
 use super::options::QuadricMode;
 use super::options::VirtualPairs;
-use super::options::{BoundaryMode, SimplifyOptions};
+use super::options::{BoundaryMode, SimplifyOptions, SEAM_PLANE_WEIGHT};
 use super::orientation::{InputSurface, Quick};
 use super::pair_set::PairSet;
 use super::pass_blocks::{
@@ -646,9 +646,10 @@ impl Engine {
         }
     }
 
-    /// Seam edges get the borders' constraint planes (with [`BoundaryMode::Planes`]),
-    /// one for each triangle on the edge, so that a seam keeps its curve as a border
-    /// does ([`super::wedges`]).
+    /// Seam edges get constraint planes like the borders' (with [`BoundaryMode::Planes`]
+    /// of a weight above 0), one for each triangle on the edge, so that a seam keeps
+    /// its curve as a border does ([`super::wedges`]); their weight is
+    /// [`SEAM_PLANE_WEIGHT`], not the borders'.
     fn add_seam_planes(&mut self, options: &SimplifyOptions, area_offset: Option<f64>) {
         let BoundaryMode::Planes(w) = options.boundary else {
             return;
@@ -661,7 +662,7 @@ impl Engine {
         }
         let seams = wedges.seam_edges(&self.incidence, &self.triangles, self.world.len());
         for (v, x, t) in seams {
-            self.add_constraint_plane([v, x], t, w, area_offset);
+            self.add_constraint_plane([v, x], t, SEAM_PLANE_WEIGHT, area_offset);
         }
     }
 

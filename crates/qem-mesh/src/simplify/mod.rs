@@ -62,6 +62,7 @@ pub use options::{
     AttributeWeights, BoundaryMode, ContractionOrder, Length, Method, PlacementMode, QuadricMode,
     SimplifyOptions, Target, VirtualPairs, Weighting, DEFAULT_BOUNDARY_WEIGHT,
     DEFAULT_MAX_NORMAL_ANGLE, DEFAULT_MIN_TRIANGLE_QUALITY, DEFAULT_WEIGHTING_MIX,
+    SEAM_PLANE_WEIGHT,
 };
 pub use relaxation::{Constraint, Relaxation, RelaxationStep};
 pub use replay::StoreReplay;

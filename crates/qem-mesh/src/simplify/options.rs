@@ -357,18 +357,32 @@ pub enum Method {
     Clustering,
 }
 
-/// The default border-plane weight of [`BoundaryMode::Planes`]: a border plane then
-/// weighs about as much as the faces around its edge together.
+/// The default border-plane weight of [`BoundaryMode::Planes`]: moving a border vertex
+/// off its border line costs about ten times as much as moving it as far off its
+/// faces' plane (meshoptimizer weighs its border edges by 10 too: `kEdgeWeightBorder`
+/// in its `simplifier.cpp`).
 ///
-/// Measured with `examples/quality_sweep.rs` on the 7 corpus meshes with borders (of
-/// 13), ratios 0.1 and 0.02, weights 0.1 to 100: no weight loses a border loop (the
-/// loop rule's doing, see [`BoundaryMode`]; one multipart mesh gains 2–4 loops where
-/// contractions tear it), while free borders lose loops on 3 of the 7; without planes the area
-/// shrinks by 5.2% (ratio 0.1) and 9.9% (0.02) on average, with weight 1 it changes by
-/// 0.8% and 6.0% (the lowest at 0.02; 0.77–0.81% for weights 0.5–100 at 0.1), while
-/// larger weights keep the border length closer (1.8% → 0.3% at 0.1) but shrink a
-/// multipart mesh's interior more at 0.02 (mean area change 9.5% at weight 100).
-pub const DEFAULT_BOUNDARY_WEIGHT: f64 = 1.0;
+/// Measured on 2026-12-05 against the earlier default of 1 (`scripts/compare_peers.py`,
+/// the 9 clean scans at 0.5, 0.1 and 0.01 against five peers; BENCHMARKS.md "Border
+/// weight"): cases with a Hausdorff distance at most the best peer's 15/27 → 18/27,
+/// mean error at most the best peer's 23/27 both; the Hausdorff distance of the open
+/// scans fell most (drc_bun_zipper 0.111% → 0.042% at 0.5, cgal_ChineseDragon_10kv
+/// 4.80% → 3.68% at 0.01), the closed ones are unchanged. Seams keep planes of
+/// [`SEAM_PLANE_WEIGHT`]. (First chosen with `examples/quality_sweep.rs` on 7 meshes
+/// with borders, ratios 0.1 and 0.02, weights 0.1 to 100: no weight lost a border
+/// loop; weight 1 changed the area least, larger weights kept the border length
+/// closer: 1.8% → 0.3% at 0.1.)
+pub const DEFAULT_BOUNDARY_WEIGHT: f64 = 10.0;
+
+/// The weight of the constraint planes through seam edges (a UV seam, a hard normal,
+/// a colour or material border: [`BoundaryMode::Planes`] with a weight above 0 gives
+/// them), whatever the border weight.
+///
+/// Why not the border weight: at 10, seam planes cost the textured meshes' geometry
+/// (pymeshlab_bunny10k_textured at 0.1: mean distance 0.136% → 0.248% of the diagonal,
+/// `qem measure --min-samples 200000`); 1 is the weight they had before the border
+/// weight went to 10. (meshoptimizer weighs its seam edges less than its borders too.)
+pub const SEAM_PLANE_WEIGHT: f64 = 1.0;
 
 /// The default mix `s` of [`Weighting::Mixed`] (face weight `area + s · mean area`),
 /// used with [`QuadricMode::Exact`].
