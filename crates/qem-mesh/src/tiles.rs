@@ -293,9 +293,9 @@ fn position_key(p: [f64; 3]) -> [u64; 3] {
 }
 
 impl Tile {
-    /// `simplified` (the simplification of `input`, `input`'s border vertices locked)
-    /// as a tile: the vertices at `input`'s border positions first, in `input`'s
-    /// order, then the others in their order.
+    /// `simplified` (the simplification of a tile whose border vertices, at
+    /// `border`, were locked) as a tile: the vertices at the `border` positions first,
+    /// in that order, then the others in their order.
     ///
     /// Locked vertices come out bit for bit where they were, so they are found by
     /// position. A border position no vertex of `simplified` has (its faces were all
@@ -318,13 +318,12 @@ impl Tile {
     ///     vec![[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]],
     ///     vec![[0, 2, 1]],
     /// );
-    /// let tile = Tile::border_first(&input, out);
+    /// let tile = Tile::border_first(&input.mesh.positions[..input.border_vertices], out);
     /// assert_eq!(tile.border_vertices, 2);
     /// assert_eq!(tile.mesh.positions, input.mesh.positions);
     /// assert_eq!(tile.mesh.triangles, vec![[2, 0, 1]]);
     /// ```
-    pub fn border_first(input: &Tile, simplified: IndexedMesh) -> Tile {
-        let border = &input.mesh.positions[..input.border_vertices.min(input.mesh.positions.len())];
+    pub fn border_first(border: &[[f64; 3]], simplified: IndexedMesh) -> Tile {
         let mut at: FxHashMap<[u64; 3], u32> = FxHashMap::default();
         at.reserve(simplified.positions.len().min(border.len()));
         // The first vertex at each position, so a duplicate is not taken for it.
@@ -557,8 +556,8 @@ mod tests {
                 .map(|t| t.map(|v| n - 1 - v))
                 .collect(),
         );
-        let out = Tile::border_first(&input, reversed);
         let b = input.border_vertices;
+        let out = Tile::border_first(&input.mesh.positions[..b], reversed);
         assert_eq!(out.border_vertices, b);
         assert_eq!(out.mesh.positions[..b], input.mesh.positions[..b]);
         // The others keep the simplifier's (here reversed) order; the triangles are
