@@ -338,3 +338,34 @@ fn options_the_tiles_cannot_keep_are_usage_errors() {
         assert!(stderr(&out).contains(flag[0]), "{}", stderr(&out));
     }
 }
+
+#[test]
+fn a_target_below_twice_the_border_is_warned_of() {
+    let tmp = tempfile::tempdir().expect("a temporary directory");
+    let dir = tmp.path().join("tiles");
+    split_spot(&dir);
+    // 1,171 triangles a tile: at 0.5, 585 triangles for under 200 border vertices.
+    let fine = ok(&[
+        "tiles",
+        "simplify",
+        s(&dir),
+        "--ratio",
+        "0.5",
+        "--tile",
+        "0",
+    ]);
+    assert!(!stderr(&fine).contains("warning"), "{}", stderr(&fine));
+    // At 0.05, 58 triangles.
+    let crowded = ok(&[
+        "tiles",
+        "simplify",
+        s(&dir),
+        "--ratio",
+        "0.05",
+        "--tile",
+        "0",
+    ]);
+    let err = stderr(&crowded);
+    assert!(err.contains("qem: warning: tile 0: its "), "{err}");
+    assert!(err.contains("border vertices are locked"), "{err}");
+}
