@@ -11,8 +11,10 @@
 //!   split that did not finish leaves none, and removes the old one first.
 //! - `tile-NNNNN.ply`: tile NNNNN, binary PLY with its border vertices first (as many
 //!   as the manifest's `border_vertices`).
-//! - `tile-NNNNN.simplified.ply` and `tile-NNNNN.done.json`: the simplified tile (its
-//!   border vertices first again) and its status, each written atomically, the status
+//! - `tile-NNNNN.simplified.ply` and `tile-NNNNN.done.json`: the simplified tile
+//!   (simplified with its border vertices and their neighbours locked,
+//!   `Tile::locked_vertices`; its border vertices first again) and its status, each
+//!   written atomically, the status
 //!   after the tile. A tile counts as done only when its status names this split, this
 //!   tile's file (size and CRC-32), the same options (a fingerprint) and a simplified
 //!   file of the recorded size and CRC-32; anything else (no status: a job killed
@@ -443,11 +445,15 @@ fn run_simplify(args: &SimplifyTilesArgs) -> Result<(), Failure> {
         (args.flags.triangles.is_some(), "--triangles"),
         (args.flags.lock.is_some(), "--lock"),
         (args.flags.cluster, "--cluster"),
+        // A virtual pair could join a border vertex to a vertex past its locked
+        // neighbours (see `Tile::locked_vertices`), and the sides would overlap.
+        (args.flags.pair_threshold > 0.0, "--pair-threshold"),
     ];
     if let Some((_, flag)) = refused.iter().find(|(given, _)| *given) {
         return Err(Failure::Usage(format!(
             "qem tiles simplify does not take {flag}: each tile is simplified by --ratio \
-             with its border vertices locked (clustering would not keep them)"
+             with its border vertices locked (clustering would not keep them, and \
+             virtual pairs would reach past them)"
         )));
     }
     let manifest = read_manifest(&args.dir)?;
@@ -515,15 +521,18 @@ fn simplify_tile(
         .map_err(|e| failed(&path, e))?
         .mesh;
     drop(bytes);
-    let border = entry.border_vertices.min(mesh.vertex_count());
-    let border_positions = mesh.positions[..border].to_vec();
-    let triangles_in = mesh.triangle_count();
+    let tile = Tile {
+        border_vertices: entry.border_vertices.min(mesh.vertex_count()),
+        mesh,
+    };
+    let border_positions = tile.mesh.positions[..tile.border_vertices].to_vec();
+    let triangles_in = tile.mesh.triangle_count();
+    let locked = tile.locked_vertices();
     if !args.quiet {
-        warn_crowded(k, border, triangles_in, options.target);
+        warn_crowded(k, locked.len(), triangles_in, options.target);
     }
-    let locked = options
-        .clone()
-        .with_locked_vertices((0..border as u32).collect());
+    let locked = options.clone().with_locked_vertices(locked);
+    let mesh = tile.mesh;
     let bar = simplify_bar(bars_wanted(args.quiet), &tile_name(k));
     let result = simplify_owned(mesh, &locked, &mut BarObserver::new(&bar));
     bar.finish_and_clear();
@@ -556,24 +565,23 @@ fn simplify_tile(
     Ok(status)
 }
 
-/// Warns when tile `k`'s locked border leaves little room for its target: a tile
-/// simplified to fewer triangles than about twice its border vertices keeps little
-/// more than long triangles spanning from border to border, far from the surface (on
-/// the dragon cut into 8 tiles, at ratio 0.01: 790 to 1,612 border vertices for a
-/// target of 1,089 triangles each, and a Hausdorff distance of 12.7% of the diagonal
-/// against 0.43% in one piece; in 2 tiles, 1,049 border vertices for 4,357
-/// triangles each: 0.37%; BENCHMARKS.md, "Tiles").
-fn warn_crowded(k: usize, border: usize, triangles: usize, target: Target) {
+/// Warns when tile `k`'s `locked` vertices (its border and their neighbours) leave
+/// little room for its target: a tile simplified to fewer triangles than about twice
+/// its locked vertices keeps its border strip and little more than long triangles
+/// spanning from border to border, far from the surface (BENCHMARKS.md, "Tiles": the
+/// dragon at ratio 0.01 in 8 tiles against 2).
+fn warn_crowded(k: usize, locked: usize, triangles: usize, target: Target) {
     let target = match target {
         Target::Ratio(r) => (r * triangles as f64) as usize,
         Target::Triangles(n) => n,
         Target::None => return,
     };
-    if target < 2 * border {
+    if target < 2 * locked {
         eprintln!(
-            "qem: warning: tile {k}: its {border} border vertices are locked and leave \
-             little room for {target} triangles, so the error near its borders will be \
-             large; split into larger tiles (--tile-triangles) or use a higher --ratio"
+            "qem: warning: tile {k}: its {locked} locked vertices (its border and their \
+             neighbours) leave little room for {target} triangles, so the error near its \
+             borders will be large; split into larger tiles (--tile-triangles) or use a \
+             higher --ratio"
         );
     }
 }

@@ -13,9 +13,15 @@
 //!   in its bounding box. A regular grid over the box would leave most cells of a
 //!   surface empty and the others uneven.
 //! - [`Tiling::tile`] gives one tile as its own mesh, its **border vertices first**: a
-//!   border vertex is one that triangles of more than one tile use. Locking those
-//!   (`SimplifyOptions::with_locked_vertices(0..border)`) keeps them unmoved and
-//!   present, so the tiles still meet after each is simplified on its own.
+//!   border vertex is one that triangles of more than one tile use.
+//!   [`Tile::locked_vertices`] are those and their neighbours in the tile: locking them
+//!   (`SimplifyOptions::with_locked_vertices`) leaves every triangle at the border as
+//!   it is, so the tiles still meet, edge for edge, after each is simplified on its
+//!   own. Locking the border vertices alone is not enough: each side may then absorb
+//!   the vertices next to a border vertex into its border neighbours, and both sides
+//!   build the same triangle across the corner, which overlaps (on a 4M-triangle
+//!   sphere in 5 tiles at ratio 0.1: 44 edges with three or more faces, all between
+//!   two border vertices).
 //! - [`Tile::border_first`] finds a simplified tile's border vertices again (by their
 //!   bit-identical positions, which locking keeps) and puts them first;
 //!   [`Welder`] joins tiles, merging each border vertex with the earlier tiles' vertex
@@ -300,6 +306,46 @@ fn position_key(p: [f64; 3]) -> [u64; 3] {
 }
 
 impl Tile {
+    /// The vertices to lock when this tile is simplified on its own: its border
+    /// vertices and every vertex that shares a triangle with one, ascending.
+    ///
+    /// Why the neighbours too: a contraction changes only the triangles around its
+    /// two vertices, and one whose two vertices are both locked is refused; so when
+    /// every neighbour of a border vertex is locked, no contraction involves a border
+    /// vertex, and every triangle with a border corner comes out as it went in (its
+    /// other corners are neighbours, locked too). (Virtual pairs would reach past the
+    /// neighbours: `qem tiles` refuses them.)
+    ///
+    /// ```
+    /// use qem_mesh::tiles::Tile;
+    /// use qem_mesh::IndexedMesh;
+    /// // A strip of three triangles; vertex 0 is on the border.
+    /// let tile = Tile {
+    ///     mesh: IndexedMesh::new(
+    ///         vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0], [2.0, 1.0, 0.0]],
+    ///         vec![[0, 1, 2], [1, 3, 2], [1, 4, 3]],
+    ///     ),
+    ///     border_vertices: 1,
+    /// };
+    /// assert_eq!(tile.locked_vertices(), vec![0, 1, 2]);
+    /// ```
+    pub fn locked_vertices(&self) -> Vec<u32> {
+        let n = self.mesh.positions.len();
+        let border = self.border_vertices.min(n);
+        let mut locked = vec![false; n];
+        locked[..border].fill(true);
+        for t in &self.mesh.triangles {
+            if t.iter().any(|&v| (v as usize) < border) {
+                for &v in t {
+                    if let Some(l) = locked.get_mut(v as usize) {
+                        *l = true;
+                    }
+                }
+            }
+        }
+        (0..n as u32).filter(|&v| locked[v as usize]).collect()
+    }
+
     /// `simplified` (the simplification of a tile whose border vertices, at
     /// `border`, were locked) as a tile: the vertices at the `border` positions first,
     /// in that order, then the others in their order.
@@ -545,6 +591,69 @@ mod tests {
         let tiling = Tiling::new(mesh, 10);
         assert_eq!(tiling.len(), 1);
         assert_eq!(tiling.tile(0).border_vertices, 0);
+    }
+
+    /// A bumpy sphere of about 2·n² triangles, so that no two tiles' borders run
+    /// along the same great circles.
+    fn bumpy_sphere(n: u32) -> IndexedMesh {
+        let mut mesh = sphere(n);
+        for p in &mut mesh.positions {
+            let r = 1.0 + 0.05 * (7.0 * p[0]).sin() * (5.0 * p[1]).cos() * (3.0 * p[2]).sin();
+            *p = p.map(|c| c * r);
+        }
+        mesh
+    }
+
+    /// Each tile simplified on its own with `locked` locked, then welded.
+    fn simplify_tiles(
+        tiling: &Tiling,
+        ratio: f64,
+        locked: impl Fn(&Tile) -> Vec<u32>,
+    ) -> IndexedMesh {
+        use crate::simplify::{simplify, SimplifyOptions, Target};
+        let mut welder = Welder::default();
+        for k in 0..tiling.len() {
+            let tile = tiling.tile(k);
+            let options = SimplifyOptions::DEFAULT
+                .with_target(Target::Ratio(ratio))
+                .with_locked_vertices(locked(&tile));
+            let out = simplify(&tile.mesh, &options).expect("the tile simplifies");
+            let border = &tile.mesh.positions[..tile.border_vertices];
+            let out = Tile::border_first(border, out.mesh);
+            assert_eq!(
+                out.border_vertices, tile.border_vertices,
+                "every border vertex kept"
+            );
+            welder.push(&out);
+        }
+        welder.finish()
+    }
+
+    #[test]
+    fn simplified_tiles_meet_edge_for_edge() {
+        let tiling = Tiling::new(bumpy_sphere(90), 6);
+        let merged = simplify_tiles(&tiling, 0.1, Tile::locked_vertices);
+        let info = inspect(&merged).expect("valid");
+        assert_eq!(
+            (
+                info.boundary_edges,
+                info.nonmanifold_edges,
+                info.duplicate_faces
+            ),
+            (0, 0, 0),
+            "{info:?}"
+        );
+        assert_eq!(info.welded_vertices, 0);
+    }
+
+    /// Why the neighbours are locked too: with the border vertices alone, the two
+    /// sides of a border cut the same corners and overlap there.
+    #[test]
+    fn locking_the_border_alone_lets_the_sides_overlap() {
+        let tiling = Tiling::new(bumpy_sphere(90), 6);
+        let merged = simplify_tiles(&tiling, 0.1, |t| (0..t.border_vertices as u32).collect());
+        let info = inspect(&merged).expect("valid");
+        assert!(info.nonmanifold_edges > 0, "{info:?}");
     }
 
     #[test]

@@ -344,7 +344,7 @@ fn a_target_below_twice_the_border_is_warned_of() {
     let tmp = tempfile::tempdir().expect("a temporary directory");
     let dir = tmp.path().join("tiles");
     split_spot(&dir);
-    // 1,171 triangles a tile: at 0.5, 585 triangles for under 200 border vertices.
+    // 1,171 triangles a tile: at 0.5, 585 triangles for under 200 locked vertices.
     let fine = ok(&[
         "tiles",
         "simplify",
@@ -367,5 +367,5 @@ fn a_target_below_twice_the_border_is_warned_of() {
     ]);
     let err = stderr(&crowded);
     assert!(err.contains("qem: warning: tile 0: its "), "{err}");
-    assert!(err.contains("border vertices are locked"), "{err}");
+    assert!(err.contains("locked vertices (its border"), "{err}");
 }
