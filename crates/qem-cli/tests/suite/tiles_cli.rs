@@ -340,7 +340,7 @@ fn options_the_tiles_cannot_keep_are_usage_errors() {
 }
 
 #[test]
-fn a_target_below_twice_the_border_is_warned_of() {
+fn a_target_below_twice_the_locked_vertices_is_warned_of() {
     let tmp = tempfile::tempdir().expect("a temporary directory");
     let dir = tmp.path().join("tiles");
     split_spot(&dir);
