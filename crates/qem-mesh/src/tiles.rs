@@ -226,11 +226,10 @@ fn bisect(
     ends: &mut Vec<usize>,
 ) {
     if tiles <= 1 || part.len() <= 1 {
-        // A part smaller than its share of tiles gives empty tiles after it; with
-        // `tiles` clamped to the triangle count that needs one triangle per tile at
-        // the very least, which the proportional cut below always leaves.
-        ends.push(offset + part.len());
-        for _ in 1..tiles {
+        // With at least as many triangles as tiles on entry (`new` clamps the count),
+        // the proportional cut below keeps that true on both sides, so `tiles` is 1
+        // here; the loop only keeps one end per tile should it not be.
+        for _ in 0..tiles.max(1) {
             ends.push(offset + part.len());
         }
         return;
