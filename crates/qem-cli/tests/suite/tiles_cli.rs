@@ -369,3 +369,36 @@ fn a_target_below_twice_the_locked_vertices_is_warned_of() {
     assert!(err.contains("qem: warning: tile 0: its "), "{err}");
     assert!(err.contains("locked vertices (its border"), "{err}");
 }
+
+/// Several jobs on one directory at once (a scheduler may start a tile's job twice, or
+/// a whole run beside an array job) finish with the files of one job alone.
+#[test]
+fn jobs_running_at_once_leave_the_files_of_one_job() {
+    let tmp = tempfile::tempdir().expect("a temporary directory");
+    let (alone, shared) = (tmp.path().join("alone"), tmp.path().join("shared"));
+    split_spot(&alone);
+    split_spot(&shared);
+    ok(&["tiles", "simplify", s(&alone), "--ratio", "0.3", "-q"]);
+    let jobs: Vec<std::process::Child> = [
+        &[][..],
+        &["--tile", "2"],
+        &[],
+        &["--tile", "4"],
+        &["--tile", "2"],
+    ]
+    .iter()
+    .map(|extra| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_qem"))
+            .args(["tiles", "simplify", s(&shared), "--ratio", "0.3", "-q"])
+            .args(*extra)
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("qem starts")
+    })
+    .collect();
+    for job in jobs {
+        let out = job.wait_with_output().expect("qem runs");
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    assert_eq!(files(&shared), files(&alone));
+}
