@@ -16,6 +16,7 @@ mod options;
 mod progress;
 mod report;
 mod simplify_cmd;
+mod tiles_cmd;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -41,6 +42,9 @@ enum Command {
     /// duplicate and degenerate faces, bounding box.
     #[command(after_long_help = info_cmd::DEFINITIONS)]
     Info(info_cmd::InfoArgs),
+    /// The tile pipeline as separate jobs: `split` a mesh into spatial tiles,
+    /// `simplify` each (borders locked), `merge` them back (borders welded).
+    Tiles(tiles_cmd::TilesArgs),
 }
 
 fn main() -> ExitCode {
@@ -51,6 +55,7 @@ fn main() -> ExitCode {
         Command::Measure(args) => measure_cmd::run(&args).map_err(failure::Failure::Failed),
         Command::Batch(args) => batch_cmd::run(&args),
         Command::Info(args) => info_cmd::run(&args),
+        Command::Tiles(args) => tiles_cmd::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

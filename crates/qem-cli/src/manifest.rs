@@ -69,6 +69,14 @@ pub struct OutputStamp {
 }
 
 impl OutputStamp {
+    /// The stamp of a file holding `bytes`.
+    pub fn of_bytes(bytes: &[u8]) -> OutputStamp {
+        OutputStamp {
+            size: bytes.len() as u64,
+            crc32: crc32fast::hash(bytes),
+        }
+    }
+
     /// Reads `path` through to stamp it; `None` when it cannot be read.
     pub fn of(path: &Path) -> Option<OutputStamp> {
         let mut file = File::open(path).ok()?;

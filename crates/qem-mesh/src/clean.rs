@@ -341,7 +341,7 @@ fn face_fate(
 }
 
 /// The bit pattern of a coordinate, with `-0.0` read as `+0.0`.
-fn coordinate_bits(c: f64) -> u64 {
+pub(crate) fn coordinate_bits(c: f64) -> u64 {
     if c == 0.0 {
         0
     } else {

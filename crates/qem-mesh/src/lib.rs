@@ -8,6 +8,8 @@
 //! - [`pairs`]: virtual pairs (close vertices that share no edge) from a uniform grid.
 //! - [`simplify`]: the Garland–Heckbert contraction loop, its options and report.
 //! - [`cluster`]: vertex clustering on a grid (fast, any input, topology not kept).
+//! - [`tiles`]: a mesh cut into spatial tiles with their borders found, and tiles welded
+//!   back together (the geometry of `qem tiles`).
 //! - `io` (feature `io`): readers and writers for OBJ, PLY, STL, OFF and glTF
 //!   (`.gltf`, `.glb`), with `.gz`.
 #![forbid(unsafe_code)]
@@ -23,6 +25,7 @@ pub mod measure;
 pub mod pairs;
 pub mod simplify;
 pub mod store;
+pub mod tiles;
 
 pub use input::{IndexedMesh, InputError, MAX_ELEMENTS};
 pub use store::{

@@ -17,3 +17,4 @@ mod measure_cli;
 mod quality_flags_cli;
 mod simplify_cli;
 mod soak;
+mod tiles_cli;

@@ -1,0 +1,689 @@
+//! Spatial tiles: a mesh cut into pieces that are simplified one at a time, each with
+//! its border locked, and welded back together.
+//!
+//! This is the geometry of `qem tiles split | simplify | merge` (and of the
+//! out-of-core and distributed runs built on it); the files, the manifest and the
+//! bookkeeping of which tile is done live in the command.
+//!
+//! - [`Tiling::new`] welds the vertices with bit-identical positions (so an STL soup,
+//!   whose facets share no vertex, has its border found by position), and cuts the
+//!   triangles into tiles by a k-d bisection of their centroids: the set (or part of
+//!   it) whose centroids spread furthest along an axis is cut at the median along that
+//!   axis, so tiles get equal triangle counts (within one) wherever the surface lies
+//!   in its bounding box. A regular grid over the box would leave most cells of a
+//!   surface empty and the others uneven.
+//! - [`Tiling::tile`] gives one tile as its own mesh, its **border vertices first**: a
+//!   border vertex is one that triangles of more than one tile use.
+//!   [`Tile::locked_vertices`] are those and their neighbours in the tile: locking them
+//!   (`SimplifyOptions::with_locked_vertices`) leaves every triangle at the border as
+//!   it is, so the tiles still meet, edge for edge, after each is simplified on its
+//!   own. Locking the border vertices alone is not enough: each side may then absorb
+//!   the vertices next to a border vertex into its border neighbours, and both sides
+//!   build the same triangle across the corner, which overlaps (on a 4M-triangle
+//!   sphere in 5 tiles at ratio 0.1: 44 edges with three or more faces, all between
+//!   two border vertices).
+//! - [`Tile::border_first`] finds a simplified tile's border vertices again (by their
+//!   bit-identical positions, which locking keeps) and puts them first;
+//!   [`Welder`] joins tiles, merging each border vertex with the earlier tiles' vertex
+//!   at the same position.
+//!
+//! Everything is deterministic: the same mesh and tile count give the same tiles, bit
+//! for bit (ties between equal centroid coordinates go by triangle number).
+
+use crate::clean::{clean, coordinate_bits, CleanOptions};
+use crate::IndexedMesh;
+use rustc_hash::FxHashMap;
+use std::cmp::Ordering;
+
+/// A mesh's triangles cut into spatial tiles (see the [module docs](self)).
+#[derive(Clone, Debug)]
+pub struct Tiling {
+    /// The input, welded (bit-identical positions merged), positions and triangles only.
+    mesh: IndexedMesh,
+    /// The triangles of every tile, tile after tile, each tile's in input order.
+    triangles: Vec<u32>,
+    /// Where each tile's triangles start in `triangles` (one more entry than tiles).
+    starts: Vec<usize>,
+    /// Whether triangles of more than one tile use each vertex.
+    border: Vec<bool>,
+    /// Each tile's box of triangle centroids.
+    boxes: Vec<([f64; 3], [f64; 3])>,
+    /// Vertices merged into another with the same position by the weld.
+    welded: usize,
+}
+
+/// One tile as a mesh of its own.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Tile {
+    /// The tile's vertices (border vertices first) and triangles.
+    pub mesh: IndexedMesh,
+    /// How many of the first vertices are border vertices (used by other tiles too).
+    pub border_vertices: usize,
+}
+
+impl Tiling {
+    /// Cuts `mesh` into `tiles` tiles (at least 1, at most one per triangle) of equal
+    /// triangle counts (within one). Attributes are not carried: tiles hold positions
+    /// and triangles only.
+    ///
+    /// Memory: besides the welded copy of the mesh (24 bytes a vertex, 12 a
+    /// triangle), the cut holds 28 bytes a triangle (its centroid in f64 and its
+    /// number) and the border flags 5 bytes a vertex; the weld itself sorts 32 bytes a
+    /// vertex while the input is still held. `mesh` is expected to have passed
+    /// [`IndexedMesh::validate`]; triangles with an index out of range are dropped
+    /// rather than trusted.
+    ///
+    /// ```
+    /// use qem_mesh::tiles::Tiling;
+    /// use qem_mesh::IndexedMesh;
+    /// // Two triangles side by side, sharing the edge 1-2.
+    /// let mesh = IndexedMesh::new(
+    ///     vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]],
+    ///     vec![[0, 1, 2], [1, 3, 2]],
+    /// );
+    /// let tiling = Tiling::new(mesh, 2);
+    /// assert_eq!(tiling.len(), 2);
+    /// let first = tiling.tile(0);
+    /// assert_eq!(first.border_vertices, 2); // vertices 1 and 2, now numbered 0 and 1
+    /// assert_eq!(first.mesh.positions[..2], [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+    /// ```
+    pub fn new(mut mesh: IndexedMesh, tiles: usize) -> Tiling {
+        // Only the exact weld: degenerate and duplicate faces are each tile's
+        // simplifier's to drop, as an in-core run drops them after the same weld.
+        let options = CleanOptions::DEFAULT
+            .with_drop_repeated_index(false)
+            .with_drop_zero_area(false)
+            .with_drop_duplicates(false);
+        // Taken by value so the input is dropped once welded: two copies at the peak,
+        // not three. Attributes first: the cleaning would copy their value lists.
+        mesh.attributes = Default::default();
+        let cleaned = clean(&mesh, &options);
+        drop(mesh);
+        Tiling::of_welded(cleaned.mesh, cleaned.report.welded_vertices, tiles)
+    }
+
+    fn of_welded(mesh: IndexedMesh, welded: usize, tiles: usize) -> Tiling {
+        let count = mesh.triangles.len();
+        let tiles = tiles.clamp(1, count.max(1));
+        let centroids: Vec<[f64; 3]> = mesh
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+                std::array::from_fn(|k| (a[k] + b[k] + c[k]) / 3.0)
+            })
+            .collect();
+        let mut triangles: Vec<u32> = (0..count as u32).collect();
+        let mut ends = Vec::with_capacity(tiles);
+        bisect(&mut triangles, 0, tiles, &centroids, &mut ends);
+        let mut starts = Vec::with_capacity(tiles + 1);
+        starts.push(0);
+        starts.extend_from_slice(&ends);
+        let mut boxes = Vec::with_capacity(tiles);
+        for w in starts.windows(2) {
+            let part = &mut triangles[w[0]..w[1]];
+            // Input order inside a tile: the file's locality, and one answer.
+            part.sort_unstable();
+            boxes.push(bounds(part.iter().map(|&t| centroids[t as usize])));
+        }
+        drop(centroids);
+        let border = border_flags(&mesh, &triangles, &starts);
+        Tiling {
+            mesh,
+            triangles,
+            starts,
+            border,
+            boxes,
+            welded,
+        }
+    }
+
+    /// The number of tiles.
+    pub fn len(&self) -> usize {
+        self.starts.len() - 1
+    }
+
+    /// Whether there are no tiles (never: a tiling has at least one, possibly empty).
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The welded mesh the tiles are cut from (positions and triangles only).
+    pub fn welded_mesh(&self) -> &IndexedMesh {
+        &self.mesh
+    }
+
+    /// How many vertices the weld merged into another with the same position.
+    pub fn welded_vertices(&self) -> usize {
+        self.welded
+    }
+
+    /// The number of triangles in tile `k`.
+    ///
+    /// # Panics
+    /// When `k >= self.len()`.
+    pub fn triangle_count(&self, k: usize) -> usize {
+        self.starts[k + 1] - self.starts[k]
+    }
+
+    /// The box (min, max) of tile `k`'s triangle centroids.
+    ///
+    /// # Panics
+    /// When `k >= self.len()`.
+    pub fn centroid_box(&self, k: usize) -> ([f64; 3], [f64; 3]) {
+        self.boxes[k]
+    }
+
+    /// Tile `k` as a mesh: its triangles in input order, its border vertices first,
+    /// then the others, each group in input order.
+    ///
+    /// # Panics
+    /// When `k >= self.len()`.
+    pub fn tile(&self, k: usize) -> Tile {
+        let part = &self.triangles[self.starts[k]..self.starts[k + 1]];
+        let mut used: Vec<u32> = part
+            .iter()
+            .flat_map(|&t| self.mesh.triangles[t as usize])
+            .collect();
+        used.sort_unstable();
+        used.dedup();
+        // local[i]: the tile's number for `used[i]`; border vertices numbered first.
+        let mut local = vec![0u32; used.len()];
+        let mut positions = Vec::with_capacity(used.len());
+        for border in [true, false] {
+            for (i, &v) in used.iter().enumerate() {
+                if self.border[v as usize] == border {
+                    local[i] = positions.len() as u32;
+                    positions.push(self.mesh.positions[v as usize]);
+                }
+            }
+        }
+        let border_vertices = used.iter().filter(|&&v| self.border[v as usize]).count();
+        let triangles = part
+            .iter()
+            .map(|&t| {
+                self.mesh.triangles[t as usize].map(|v| {
+                    // Every corner is in `used`, built from these very triangles.
+                    let i = used.binary_search(&v).unwrap_or(0);
+                    local[i]
+                })
+            })
+            .collect();
+        Tile {
+            mesh: IndexedMesh::new(positions, triangles),
+            border_vertices,
+        }
+    }
+}
+
+/// Cuts `part` (triangle numbers, at `offset` in the whole list) into `tiles` tiles,
+/// pushing each tile's end (an index into the whole list) to `ends`, left to right.
+fn bisect(
+    part: &mut [u32],
+    offset: usize,
+    tiles: usize,
+    centroids: &[[f64; 3]],
+    ends: &mut Vec<usize>,
+) {
+    if tiles <= 1 || part.len() <= 1 {
+        // With at least as many triangles as tiles on entry (`new` clamps the count),
+        // the proportional cut below keeps that true on both sides, so `tiles` is 1
+        // here; the loop only keeps one end per tile should it not be.
+        for _ in 0..tiles.max(1) {
+            ends.push(offset + part.len());
+        }
+        return;
+    }
+    let (min, max) = bounds(part.iter().map(|&t| centroids[t as usize]));
+    // The axis of the largest spread; the first of equals, so the choice is one.
+    let axis = (0..3)
+        .max_by(|&a, &b| {
+            (max[a] - min[a])
+                .total_cmp(&(max[b] - min[b]))
+                .then(b.cmp(&a))
+        })
+        .unwrap_or(0);
+    let left_tiles = tiles / 2;
+    // Proportional, so that every tile ends up with its share (within one).
+    let cut = part.len() * left_tiles / tiles;
+    // Unique keys (coordinate, then triangle number): the two sides are the same
+    // sets whatever the selection algorithm does.
+    let key = |&a: &u32, &b: &u32| -> Ordering {
+        centroids[a as usize][axis]
+            .total_cmp(&centroids[b as usize][axis])
+            .then(a.cmp(&b))
+    };
+    if cut > 0 && cut < part.len() {
+        part.select_nth_unstable_by(cut, key);
+    }
+    let (left, right) = part.split_at_mut(cut);
+    bisect(left, offset, left_tiles, centroids, ends);
+    bisect(right, offset + cut, tiles - left_tiles, centroids, ends);
+}
+
+/// The box (min, max) of `points`; an empty box (min > max) when there are none.
+fn bounds(points: impl Iterator<Item = [f64; 3]>) -> ([f64; 3], [f64; 3]) {
+    points.fold(
+        ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
+        |(lo, hi), p| {
+            (
+                std::array::from_fn(|k| lo[k].min(p[k])),
+                std::array::from_fn(|k| hi[k].max(p[k])),
+            )
+        },
+    )
+}
+
+/// Whether triangles of more than one tile use each vertex of `mesh`.
+fn border_flags(mesh: &IndexedMesh, triangles: &[u32], starts: &[usize]) -> Vec<bool> {
+    const NONE: u32 = u32::MAX;
+    let n = mesh.positions.len();
+    // The first tile seen using each vertex.
+    let mut first = vec![NONE; n];
+    let mut border = vec![false; n];
+    for (k, w) in starts.windows(2).enumerate() {
+        for &t in &triangles[w[0]..w[1]] {
+            for v in mesh.triangles[t as usize] {
+                let v = v as usize;
+                if v >= n {
+                    continue;
+                }
+                if first[v] == NONE {
+                    first[v] = k as u32;
+                } else if first[v] != k as u32 {
+                    border[v] = true;
+                }
+            }
+        }
+    }
+    border
+}
+
+/// The bit pattern of a position, `-0.0` read as `+0.0` (as the exact weld does).
+fn position_key(p: [f64; 3]) -> [u64; 3] {
+    p.map(coordinate_bits)
+}
+
+impl Tile {
+    /// The vertices to lock when this tile is simplified on its own: its border
+    /// vertices and every vertex that shares a triangle with one, ascending.
+    ///
+    /// Why the neighbours too: a contraction changes only the triangles around its
+    /// two vertices, and one whose two vertices are both locked is refused; so when
+    /// every neighbour of a border vertex is locked, no contraction involves a border
+    /// vertex, and every triangle with a border corner comes out as it went in (its
+    /// other corners are neighbours, locked too). (Virtual pairs would reach past the
+    /// neighbours: `qem tiles` refuses them.)
+    ///
+    /// ```
+    /// use qem_mesh::tiles::Tile;
+    /// use qem_mesh::IndexedMesh;
+    /// // A strip of three triangles; vertex 0 is on the border.
+    /// let tile = Tile {
+    ///     mesh: IndexedMesh::new(
+    ///         vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0], [2.0, 1.0, 0.0]],
+    ///         vec![[0, 1, 2], [1, 3, 2], [1, 4, 3]],
+    ///     ),
+    ///     border_vertices: 1,
+    /// };
+    /// assert_eq!(tile.locked_vertices(), vec![0, 1, 2]);
+    /// ```
+    pub fn locked_vertices(&self) -> Vec<u32> {
+        let n = self.mesh.positions.len();
+        let border = self.border_vertices.min(n);
+        let mut locked = vec![false; n];
+        locked[..border].fill(true);
+        for t in &self.mesh.triangles {
+            if t.iter().any(|&v| (v as usize) < border) {
+                for &v in t {
+                    if let Some(l) = locked.get_mut(v as usize) {
+                        *l = true;
+                    }
+                }
+            }
+        }
+        (0..n as u32).filter(|&v| locked[v as usize]).collect()
+    }
+
+    /// `simplified` (the simplification of a tile whose border vertices, at
+    /// `border`, were locked) as a tile: the vertices at the `border` positions first,
+    /// in that order, then the others in their order.
+    ///
+    /// Locked vertices come out bit for bit where they were, so they are found by
+    /// position. A border position no vertex of `simplified` has (its faces were all
+    /// dropped as degenerate by the cleaning) is left out; were two vertices at one
+    /// border position (a vertex placed exactly on a locked one), the first is the
+    /// border vertex.
+    ///
+    /// ```
+    /// use qem_mesh::tiles::Tile;
+    /// use qem_mesh::IndexedMesh;
+    /// let input = Tile {
+    ///     mesh: IndexedMesh::new(
+    ///         vec![[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 0.0]],
+    ///         vec![[2, 0, 1]],
+    ///     ),
+    ///     border_vertices: 2,
+    /// };
+    /// // A simplifier's output with the vertices in another order.
+    /// let out = IndexedMesh::new(
+    ///     vec![[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]],
+    ///     vec![[0, 2, 1]],
+    /// );
+    /// let tile = Tile::border_first(&input.mesh.positions[..input.border_vertices], out);
+    /// assert_eq!(tile.border_vertices, 2);
+    /// assert_eq!(tile.mesh.positions, input.mesh.positions);
+    /// assert_eq!(tile.mesh.triangles, vec![[2, 0, 1]]);
+    /// ```
+    pub fn border_first(border: &[[f64; 3]], simplified: IndexedMesh) -> Tile {
+        let mut at: FxHashMap<[u64; 3], u32> = FxHashMap::default();
+        at.reserve(simplified.positions.len().min(border.len()));
+        // The first vertex at each position, so a duplicate is not taken for it.
+        for (i, p) in simplified.positions.iter().enumerate().rev() {
+            at.insert(position_key(*p), i as u32);
+        }
+        const UNSET: u32 = u32::MAX;
+        let mut new_of = vec![UNSET; simplified.positions.len()];
+        let mut positions = Vec::with_capacity(simplified.positions.len());
+        for p in border {
+            if let Some(&i) = at.get(&position_key(*p)) {
+                if new_of[i as usize] == UNSET {
+                    new_of[i as usize] = positions.len() as u32;
+                    positions.push(simplified.positions[i as usize]);
+                }
+            }
+        }
+        let border_vertices = positions.len();
+        for (i, p) in simplified.positions.iter().enumerate() {
+            if new_of[i] == UNSET {
+                new_of[i] = positions.len() as u32;
+                positions.push(*p);
+            }
+        }
+        let triangles = simplified
+            .triangles
+            .iter()
+            .map(|t| t.map(|v| new_of.get(v as usize).copied().unwrap_or(v)))
+            .collect();
+        Tile {
+            mesh: IndexedMesh::new(positions, triangles).with_attributes(simplified.attributes),
+            border_vertices,
+        }
+    }
+}
+
+/// Joins tiles into one mesh, merging each tile's border vertices with the vertex an
+/// earlier tile has at the same (bit-identical) position; the other vertices are
+/// taken as they are. Positions and triangles only.
+///
+/// ```
+/// use qem_mesh::tiles::{Tiling, Welder};
+/// use qem_mesh::IndexedMesh;
+/// let mesh = IndexedMesh::new(
+///     vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]],
+///     vec![[0, 1, 2], [1, 3, 2]],
+/// );
+/// let tiling = Tiling::new(mesh, 2);
+/// let mut welder = Welder::default();
+/// for k in 0..tiling.len() {
+///     welder.push(&tiling.tile(k));
+/// }
+/// let joined = welder.finish();
+/// assert_eq!(joined.vertex_count(), 4);
+/// assert_eq!(joined.triangle_count(), 2);
+/// ```
+#[derive(Debug, Default)]
+pub struct Welder {
+    mesh: IndexedMesh,
+    /// The joined mesh's vertex at each border position seen so far.
+    border: FxHashMap<[u64; 3], u32>,
+}
+
+impl Welder {
+    /// Appends `tile`. Indices out of range in its triangles are kept as they are
+    /// (offset like the others), for the joined mesh's validation to refuse.
+    pub fn push(&mut self, tile: &Tile) {
+        let base = self.mesh.positions.len();
+        let mut number = Vec::with_capacity(tile.mesh.positions.len());
+        for (i, p) in tile.mesh.positions.iter().enumerate() {
+            let fresh = self.mesh.positions.len() as u32;
+            let n = if i < tile.border_vertices {
+                *self.border.entry(position_key(*p)).or_insert(fresh)
+            } else {
+                fresh
+            };
+            if n == fresh {
+                self.mesh.positions.push(*p);
+            }
+            number.push(n);
+        }
+        self.mesh
+            .triangles
+            .extend(tile.mesh.triangles.iter().map(|t| {
+                t.map(|v| match number.get(v as usize) {
+                    Some(&n) => n,
+                    None => (base + v as usize).min(u32::MAX as usize) as u32,
+                })
+            }));
+    }
+
+    /// The joined mesh.
+    pub fn finish(self) -> IndexedMesh {
+        self.mesh
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::inspect::inspect;
+
+    /// A closed UV sphere of `n` x `n` quads (poles welded by the tiling's weld).
+    fn sphere(n: u32) -> IndexedMesh {
+        let mut positions = Vec::new();
+        for j in 0..=n {
+            for i in 0..n {
+                let (theta, phi) = (
+                    i as f64 * std::f64::consts::TAU / n as f64,
+                    j as f64 * std::f64::consts::PI / n as f64,
+                );
+                // The poles written as one point, so the weld merges their ring.
+                let (s, z) = if j == 0 || j == n {
+                    (0.0, if j == 0 { 1.0 } else { -1.0 })
+                } else {
+                    (phi.sin(), phi.cos())
+                };
+                positions.push([s * theta.cos(), s * theta.sin(), z]);
+            }
+        }
+        let mut triangles = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                let a = j * n + i;
+                let b = j * n + (i + 1) % n;
+                if j > 0 {
+                    triangles.push([a, a + n, b]);
+                }
+                if j + 1 < n {
+                    triangles.push([b, a + n, b + n]);
+                }
+            }
+        }
+        IndexedMesh::new(positions, triangles)
+    }
+
+    #[test]
+    fn tiles_have_equal_counts_and_cover_every_triangle_once() {
+        let mesh = sphere(24);
+        let tiling = Tiling::new(mesh.clone(), 7);
+        assert_eq!(tiling.len(), 7);
+        let counts: Vec<usize> = (0..7).map(|k| tiling.triangle_count(k)).collect();
+        let total: usize = counts.iter().sum();
+        assert_eq!(total, mesh.triangle_count());
+        let (lo, hi) = (counts.iter().min(), counts.iter().max());
+        assert!(hi.zip(lo).is_some_and(|(h, l)| h - l <= 1), "{counts:?}");
+        let mut seen = tiling.triangles.clone();
+        seen.sort_unstable();
+        assert_eq!(seen, (0..total as u32).collect::<Vec<_>>());
+    }
+
+    #[test]
+    fn welding_the_tiles_gives_back_the_closed_sphere() {
+        let mesh = sphere(24);
+        let before = inspect(&mesh).expect("valid");
+        let tiling = Tiling::new(mesh.clone(), 5);
+        let mut welder = Welder::default();
+        for k in 0..tiling.len() {
+            let tile = tiling.tile(k);
+            // Border vertices really are used by another tile, and the first ones.
+            assert!(tile.border_vertices > 0);
+            welder.push(&tile);
+        }
+        let joined = welder.finish();
+        let after = inspect(&joined).expect("valid");
+        assert_eq!(after.boundary_edges, 0);
+        assert_eq!(after.welded_vertices, 0, "every shared vertex was welded");
+        assert_eq!(joined.triangle_count(), mesh.triangle_count());
+        assert_eq!(
+            joined.vertex_count(),
+            before.vertices - before.welded_vertices
+        );
+    }
+
+    #[test]
+    fn a_soup_has_its_border_found_by_position() {
+        let mesh = sphere(12);
+        // Every triangle with three vertices of its own, as STL gives them.
+        let positions: Vec<[f64; 3]> = mesh
+            .triangles
+            .iter()
+            .flat_map(|t| t.map(|v| mesh.positions[v as usize]))
+            .collect();
+        let triangles = (0..mesh.triangle_count() as u32)
+            .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+            .collect();
+        let soup = IndexedMesh::new(positions, triangles);
+        let tiling = Tiling::new(soup, 3);
+        let mut welder = Welder::default();
+        for k in 0..3 {
+            welder.push(&tiling.tile(k));
+        }
+        let joined = welder.finish();
+        assert_eq!(inspect(&joined).expect("valid").boundary_edges, 0);
+    }
+
+    #[test]
+    fn the_same_mesh_gives_the_same_tiles() {
+        let mesh = sphere(16);
+        let (a, b) = (Tiling::new(mesh.clone(), 6), Tiling::new(mesh, 6));
+        for k in 0..6 {
+            assert_eq!(a.tile(k), b.tile(k));
+        }
+    }
+
+    #[test]
+    fn more_tiles_than_triangles_gives_one_triangle_each() {
+        let mesh = IndexedMesh::new(
+            vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            vec![[0, 1, 2]],
+        );
+        let tiling = Tiling::new(mesh, 10);
+        assert_eq!(tiling.len(), 1);
+        assert_eq!(tiling.tile(0).border_vertices, 0);
+    }
+
+    /// A bumpy sphere of about 2·n² triangles, so that no two tiles' borders run
+    /// along the same great circles.
+    fn bumpy_sphere(n: u32) -> IndexedMesh {
+        let mut mesh = sphere(n);
+        for p in &mut mesh.positions {
+            let r = 1.0 + 0.05 * (7.0 * p[0]).sin() * (5.0 * p[1]).cos() * (3.0 * p[2]).sin();
+            *p = p.map(|c| c * r);
+        }
+        mesh
+    }
+
+    /// Each tile simplified on its own with `locked` locked, then welded.
+    fn simplify_tiles(
+        tiling: &Tiling,
+        ratio: f64,
+        locked: impl Fn(&Tile) -> Vec<u32>,
+    ) -> IndexedMesh {
+        use crate::simplify::{simplify, SimplifyOptions, Target};
+        let mut welder = Welder::default();
+        for k in 0..tiling.len() {
+            let tile = tiling.tile(k);
+            let options = SimplifyOptions::DEFAULT
+                .with_target(Target::Ratio(ratio))
+                .with_locked_vertices(locked(&tile));
+            let out = simplify(&tile.mesh, &options).expect("the tile simplifies");
+            let border = &tile.mesh.positions[..tile.border_vertices];
+            let out = Tile::border_first(border, out.mesh);
+            assert_eq!(
+                out.border_vertices, tile.border_vertices,
+                "every border vertex kept"
+            );
+            welder.push(&out);
+        }
+        welder.finish()
+    }
+
+    #[test]
+    fn simplified_tiles_meet_edge_for_edge() {
+        let tiling = Tiling::new(bumpy_sphere(90), 6);
+        let merged = simplify_tiles(&tiling, 0.1, Tile::locked_vertices);
+        let info = inspect(&merged).expect("valid");
+        assert_eq!(
+            (
+                info.boundary_edges,
+                info.nonmanifold_edges,
+                info.duplicate_faces
+            ),
+            (0, 0, 0),
+            "{info:?}"
+        );
+        assert_eq!(info.welded_vertices, 0);
+    }
+
+    /// Why the neighbours are locked too: with the border vertices alone, the two
+    /// sides of a border cut the same corners and overlap there.
+    #[test]
+    fn locking_the_border_alone_lets_the_sides_overlap() {
+        let tiling = Tiling::new(bumpy_sphere(90), 6);
+        let merged = simplify_tiles(&tiling, 0.1, |t| (0..t.border_vertices as u32).collect());
+        let info = inspect(&merged).expect("valid");
+        assert!(info.nonmanifold_edges > 0, "{info:?}");
+    }
+
+    #[test]
+    fn border_first_finds_locked_vertices_by_position() {
+        let mesh = sphere(12);
+        let tiling = Tiling::new(mesh, 2);
+        let input = tiling.tile(1);
+        // The same tile, its vertices reversed: the border comes back first.
+        let n = input.mesh.positions.len() as u32;
+        let reversed = IndexedMesh::new(
+            input.mesh.positions.iter().rev().copied().collect(),
+            input
+                .mesh
+                .triangles
+                .iter()
+                .map(|t| t.map(|v| n - 1 - v))
+                .collect(),
+        );
+        let b = input.border_vertices;
+        let out = Tile::border_first(&input.mesh.positions[..b], reversed);
+        assert_eq!(out.border_vertices, b);
+        assert_eq!(out.mesh.positions[..b], input.mesh.positions[..b]);
+        // The others keep the simplifier's (here reversed) order; the triangles are
+        // the same corners.
+        let corners = |m: &IndexedMesh| -> Vec<[[f64; 3]; 3]> {
+            m.triangles
+                .iter()
+                .map(|t| t.map(|v| m.positions[v as usize]))
+                .collect()
+        };
+        assert_eq!(corners(&out.mesh), corners(&input.mesh));
+        assert_eq!(out.mesh.positions[b], input.mesh.positions[n as usize - 1]);
+    }
+}
