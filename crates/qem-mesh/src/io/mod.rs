@@ -97,6 +97,8 @@ mod error;
 pub mod gltf;
 mod input;
 pub mod obj;
+#[cfg(test)]
+mod obj_legacy;
 mod off;
 mod ply;
 mod stl;
@@ -338,10 +340,10 @@ fn read_plain(
     if format != Format::Stl {
         notes.byte_order_mark = input.skip_bom()?;
     }
-    // PLY, STL and OFF are read as they arrive; OBJ (whose reader, tobj, is given the
-    // checked text) and glTF (JSON, and buffers anywhere in it) from all their bytes.
+    // PLY, STL, OFF and OBJ are read as they arrive; glTF (JSON, and buffers anywhere in
+    // it) from all its bytes.
     let mesh = match format {
-        Format::Obj => obj::read(&input.rest()?, &mut notes)?,
+        Format::Obj => obj::read(input, &mut notes)?,
         Format::Ply => ply::read(input, &mut notes)?,
         Format::Stl => stl::read(input, &mut notes)?,
         Format::Off => off::read(input, &mut notes)?,
