@@ -1766,6 +1766,56 @@ mod tests {
         assert!(kinds.len() > 10, "{kinds:?}");
     }
 
+    /// Problems whose report depends on more than their line, each as the old reader
+    /// reported it (kind, line and message; `tobj`'s own refusals had no line).
+    #[test]
+    fn hand_picked_problems_read_as_before() {
+        let tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+        let cases: Vec<(String, &str)> = vec![
+            // A bad number, then a bad face index: the index is reported (the old
+            // reader's first pass checked indices, not numbers).
+            (format!("{tri}v 1 x 0\nf 1 2 0\n"), "line 5: face 0: vertex index 0 is invalid (OBJ indices start at 1)"),
+            // A face naming a vertex defined later in its section: read.
+            (format!("f 1 2 3\n{tri}"), "ok"),
+            // ... in a later section: refused, without a line.
+            (format!("f 1 2 3\ng b\n{tri}"), "OBJ rejected: face vertex index out of bounds (line not located)"),
+            // ... and past the file's count: the face's line.
+            (format!("{tri}f 1 2 4\n"), "line 4: face 0 refers to vertex 4, but there are only 3 vertices"),
+            // An unused vertex with an infinite coordinate is dropped, not refused...
+            (format!("{tri}v inf 0 0\nf 1 2 3\n"), "ok"),
+            // ... but named when something else fails (a used NaN after it).
+            (format!("v 0 0 0\nv inf 0 0\nv 1 0 0\nv 0 nan 0\nf 1 3 4\n"), "line 2: vertex 1 has a non-finite coordinate"),
+            // An index past the file's size in bytes on a face the first pass checked
+            // in full, after a later problem of the second pass.
+            (format!("{tri}f 1 2 -1 99999999999999999\nvt x\n"), "line 4: face 0 refers to vertex 99999999999999999, but there are only"),
+            // Colours on some `v` lines only: shifted as before when in range...
+            ("v 5 5 5\nv 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nf 1 2 3\n".to_string(), "ok"),
+            // ... refused when not.
+            (format!("v 0 0 0\nv 1 0 0 1 0 0\nv 0 1 0\nf 1 2 3\n"), "OBJ rejected: face vertex color index out of bounds (line not located)"),
+            // Seven numbers on a `v` line split at a no-break space (`tobj` split there).
+            ("v 0 0 0 1 0 0\u{a0}1\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".to_string(), "OBJ rejected: color parse error (too many or too few components) (line not located)"),
+            // A continued line is located at its first line.
+            (format!("{tri}f 1 \\\n2 \\\r\n0\n"), "line 4: face 0: vertex index 0 is invalid (OBJ indices start at 1)"),
+            // A section whose first corner has no `vt` gets the file's first value.
+            ("vt 0.5 0.5\nvt 1 1\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2/2 3/2\ng b\nf 1/1 2/1 3\n".to_string(), "ok"),
+        ];
+        for (data, expected) in &cases {
+            assert_same(data.as_bytes(), data);
+            let got = match read_bytes(data.as_bytes(), Format::Obj) {
+                Ok(_) => "ok".to_string(),
+                Err(e) => e.to_string(),
+            };
+            assert!(got.starts_with(expected), "{data:?}: {got}");
+        }
+        // The one difference: a polyline (`l`) of three points or more is skipped,
+        // where the old reader (`tobj` made it a triangle) refused the file.
+        let data = format!("{tri}f 1 2 3\nl 1 2 3\n");
+        let new = read_bytes(data.as_bytes(), Format::Obj).expect("a polyline is skipped");
+        assert_eq!(new.mesh.triangles.len(), 1);
+        assert_eq!(new.notes.skipped_lines, 1);
+        assert!(old(data.as_bytes()).is_err());
+    }
+
     /// Every OBJ of the shared corpus loads as before (mesh, attributes, labels, notes);
     /// skipped when the corpus is absent.
     #[test]
