@@ -953,8 +953,10 @@ mod tests {
             ),
             (
                 "obj, a long comment, a bad index",
-                format!("{long_comment}v 0 0 0\nv 1 0 0\n{long_comment}v 0 1 0\nf 1 2 3\nf 1 2 0\n")
-                    .into_bytes(),
+                format!(
+                    "{long_comment}v 0 0 0\nv 1 0 0\n{long_comment}v 0 1 0\nf 1 2 3\nf 1 2 0\n"
+                )
+                .into_bytes(),
                 Format::Obj,
             ),
         ]

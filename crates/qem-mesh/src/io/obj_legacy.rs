@@ -3,7 +3,6 @@
 //! reader ([`super`]) gives the same meshes, notes and errors.
 #![allow(dead_code)]
 
-
 use super::text::{self, parse_f64, parse_i64, show, words};
 use std::collections::HashMap;
 
@@ -717,4 +716,3 @@ fn push_corners(dst: &mut Vec<[u32; 3]>, src: &[u32], base: u32, ntri: usize) {
         dst.push([corner(0), corner(1), corner(2)]);
     }
 }
-
