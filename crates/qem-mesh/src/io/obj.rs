@@ -1,5 +1,6 @@
 //! OBJ reader and writer. The reader streams: it reads the text a line at a time out of
-//! the window of [`Input`] (through [`TextStream`]), so neither the file nor its
+//! the window of the I/O layer's input (`io::input::Input`, through
+//! `io::text::TextStream`, as the OFF and PLY readers do), so neither the file nor its
 //! decompressed text is ever held whole.
 //!
 //! # What the reader keeps
@@ -1931,6 +1932,25 @@ mod tests {
             }
         }
         eprintln!("{} corpus OBJ files read as before", paths.len());
+    }
+
+    /// The files named in `QEM_OBJ_COMPARE` (separated by `:`) read as before: for
+    /// files too large to keep in the repository (the 4M-triangle spheres of
+    /// BENCHMARKS.md, "Loading"). `QEM_OBJ_COMPARE=/tmp/sphere4m_tex.obj cargo test -p
+    /// qem-mesh --features io --lib -- --ignored obj::tests::named`
+    #[test]
+    #[ignore = "reads the files named in QEM_OBJ_COMPARE"]
+    fn named_files_read_as_before() {
+        let names = std::env::var("QEM_OBJ_COMPARE").unwrap_or_default();
+        for name in names.split(':').filter(|n| !n.is_empty()) {
+            let data = std::fs::read(name).expect("a readable file");
+            let new = read_bytes(&data, Format::Obj);
+            let old = old(&data);
+            if let Some(d) = differ(&new, &old) {
+                panic!("{name}: {d}");
+            }
+            eprintln!("{name}: same");
+        }
     }
 
     /// The fuzz target's seeds and regressions read as before.
