@@ -553,6 +553,7 @@ mod tests {
             Format::Off => "off",
             Format::Ply => "ply",
             Format::Stl => "stl",
+            Format::Obj => "obj",
             _ => unreachable!("the streamed formats"),
         };
         let mut got = Vec::new();
@@ -941,6 +942,23 @@ mod tests {
                     .to_vec(),
                 Format::Stl,
             ),
+            (
+                "obj, bom, crlf, continuations, sections, latin-1 names, colours, relative indices",
+                b"\xEF\xBB\xBF# caf\xe9\r\nmtllib a b.mtl\r\nv 0 0 0 1 0 0\r\nv 1 0 0 0 1 0\r\n\
+                  v 1 1 0 0 0 1\r\nv 0 1 0 1 1 1\r\nvt 0 0\r\nvt 1 0\r\nvt 1 1\r\nvn 0 0 1\r\n\
+                  g caf\xe9\r\nusemtl m\r\nf 1/1/1 2/2/1 \\\r\n 3/3/1 4\r\ng b\r\n\
+                  f -4//-1 -3//-1 -2//-1\r\ns off\r\nl 1 2\r\nf 1 2 3"
+                    .to_vec(),
+                Format::Obj,
+            ),
+            (
+                "obj, a long comment, a bad index",
+                format!(
+                    "{long_comment}v 0 0 0\nv 1 0 0\n{long_comment}v 0 1 0\nf 1 2 3\nf 1 2 0\n"
+                )
+                .into_bytes(),
+                Format::Obj,
+            ),
         ]
     }
 
@@ -1167,6 +1185,7 @@ mod tests {
             ("read_ply", Format::Ply),
             ("read_stl", Format::Stl),
             ("read_off", Format::Off),
+            ("read_obj", Format::Obj),
         ] {
             for kind in ["corpus", "regressions"] {
                 let Ok(entries) = std::fs::read_dir(fuzz.join(kind).join(target)) else {

@@ -9,14 +9,14 @@
 //! function from arbitrary bytes to a mesh or an error: it never panics and never
 //! allocates more than the input can justify.
 //!
-//! **Streaming.** PLY (binary and ASCII), STL (binary and ASCII) and OFF are read as
-//! they arrive, a chunk at a time (1 MiB): binary records whole, text a line or a token
-//! at a time, so reading a file takes about the memory of the arrays it gives, not the
-//! file's (or its decompressed data's) size on top (a 4M-triangle sphere: 1.04 times
-//! the arrays as OFF or ASCII PLY, 1.01 as ASCII STL, where it was 2.7 and 3.1 times;
-//! figures in BENCHMARKS.md, "Loading"). A line (or token) longer than a chunk is
-//! held whole while it is read, costing about its length. Parsed from all their
-//! (decompressed) bytes at once: OBJ and glTF; an ASCII STL whose bytes 80..84 (control
+//! **Streaming.** PLY (binary and ASCII), STL (binary and ASCII), OFF and OBJ are read
+//! as they arrive, a chunk at a time (1 MiB): binary records whole, text a line or a
+//! token at a time, so reading a file takes about the memory of the arrays it gives,
+//! not the file's (or its decompressed data's) size on top (a 4M-triangle sphere: 1.04
+//! times the arrays as OFF or ASCII PLY, 1.01 as ASCII STL, where it was 2.7 and 3.1
+//! times; 1.21 as OBJ, where it was 8.6; figures in BENCHMARKS.md, "Loading"). A line
+//! (or token) longer than a chunk is held whole while it is read, costing about its
+//! length. Parsed from all their (decompressed) bytes at once: glTF; an ASCII STL whose bytes 80..84 (control
 //! bytes there, not text) give a binary STL count of at most `MAX_ELEMENTS` triangles
 //! and a size the data could have, since only its end says whether it is a binary
 //! file; and STL text with more than 4 KiB of whitespace before `solid`. Whatever the
@@ -31,7 +31,8 @@
 //!
 //! Polygons are fan-triangulated from their first corner. Vertices are never welded
 //! or removed by the PLY, STL and OFF readers (an STL facet gives three new vertices);
-//! see [`obj`] for what the OBJ reader (built on `tobj`) does to vertex order, and
+//! see [`obj`] for what the OBJ reader does to vertex order (numbered per `o`/`g`
+//! section, as the `tobj`-based reader before it did), and
 //! [`gltf`] for how glTF scenes, primitives and attributes become one mesh (and what
 //! of a glTF file is not carried through).
 //!
@@ -97,6 +98,8 @@ mod error;
 pub mod gltf;
 mod input;
 pub mod obj;
+#[cfg(test)]
+mod obj_legacy;
 mod off;
 mod ply;
 mod stl;
@@ -121,7 +124,8 @@ pub const SUPPORTED_EXTENSIONS: &str =
 /// Decompressed gzip data may be at most this many times the compressed size (plus
 /// 64 KiB, so tiny files are never refused).
 ///
-/// Why 64: OBJ and glTF hold the whole decompressed file in memory, and deflate can
+/// Why 64: glTF is read from the whole decompressed file (and before issue 30 OBJ was
+/// too), and deflate can
 /// expand up to about 1032:1, so a 1 MB "zip bomb" of whitespace would otherwise need
 /// over 2 GB (measured: 2.0 GB peak RSS, see FUZZING.md). Real meshes compress far less: gzip -9
 /// of the project's 49-mesh corpus gives at most 9:1 (OBJ text); 64 leaves a margin of
@@ -338,10 +342,10 @@ fn read_plain(
     if format != Format::Stl {
         notes.byte_order_mark = input.skip_bom()?;
     }
-    // PLY, STL and OFF are read as they arrive; OBJ (whose reader, tobj, is given the
-    // checked text) and glTF (JSON, and buffers anywhere in it) from all their bytes.
+    // PLY, STL, OFF and OBJ are read as they arrive; glTF (JSON, and buffers anywhere in
+    // it) from all its bytes.
     let mesh = match format {
-        Format::Obj => obj::read(&input.rest()?, &mut notes)?,
+        Format::Obj => obj::read(input, &mut notes)?,
         Format::Ply => ply::read(input, &mut notes)?,
         Format::Stl => stl::read(input, &mut notes)?,
         Format::Off => off::read(input, &mut notes)?,
