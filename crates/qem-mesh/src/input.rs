@@ -62,9 +62,11 @@ pub enum InputError {
         /// How many vertices the mesh has.
         vertex_count: usize,
     },
-    /// More vertices or triangles than [`MAX_ELEMENTS`].
+    /// More elements than a limit allows: vertices or triangles above
+    /// [`MAX_ELEMENTS`], or an OBJ file's lists of vertices, texture coordinates or
+    /// normals above 2^31 - 1 lines.
     TooLarge {
-        /// `"vertices"` or `"triangles"`.
+        /// `"vertices"`, `"triangles"`, `"texture coordinates"` or `"normals"`.
         what: &'static str,
         /// How many there are.
         count: usize,

@@ -50,7 +50,9 @@
 //! byte ([`crate::attributes::FaceLabels`]). Numbers, counts and indices stay strict: a malformed one
 //! is an error naming its line.
 //!
-//! **Bounded memory.** Counts above `MAX_ELEMENTS` are refused; no buffer is reserved
+//! **Bounded memory.** Counts above `MAX_ELEMENTS` are refused (an OBJ file may list
+//! up to 2^31 - 1 `v`, `vt` and `vn` lines, about 28 bytes each while read; only the
+//! elements its faces use count against `MAX_ELEMENTS`); no buffer is reserved
 //! beyond what the remaining bytes could hold (for gzip data, whose size is known only
 //! at its end, beyond what has arrived: the arrays grow as the data arrives); gzip
 //! output is capped at [`GZIP_MAX_RATIO`] times the compressed size and at
