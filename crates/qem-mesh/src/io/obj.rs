@@ -348,17 +348,17 @@ fn gather<T: Copy + Default>(data: &mut Vec<T>, stride: usize, src: &[u32]) {
 
 /// Distinct names in order of first appearance (the maps answer "seen, and where?").
 #[derive(Default)]
-struct Names {
-    groups: Vec<Vec<u8>>,
-    materials: Vec<Vec<u8>>,
-    libraries: Vec<Vec<u8>>,
+pub(super) struct Names {
+    pub(super) groups: Vec<Vec<u8>>,
+    pub(super) materials: Vec<Vec<u8>>,
+    pub(super) libraries: Vec<Vec<u8>>,
     seen: [FxHashMap<Vec<u8>, u32>; 3],
 }
 
 impl Names {
     /// Adds a name of kind `which` (0 groups, 1 materials, 2 libraries) and returns
     /// its index, or [`FaceLabels::NONE`] for an empty name.
-    fn add(&mut self, which: usize, name: &[u8]) -> u32 {
+    pub(super) fn add(&mut self, which: usize, name: &[u8]) -> u32 {
         if name.is_empty() {
             return FaceLabels::NONE;
         }
@@ -380,9 +380,9 @@ impl Names {
 /// Where the group or material changes: from triangle `first` on (in file order),
 /// the faces have `label`.
 #[derive(Clone, Copy)]
-struct LabelRun {
-    first: usize,
-    label: u32,
+pub(super) struct LabelRun {
+    pub(super) first: usize,
+    pub(super) label: u32,
 }
 
 /// Adds `run`; a run starting where the last one starts replaces it (the last one
@@ -397,7 +397,7 @@ fn push_run(runs: &mut Vec<LabelRun>, run: LabelRun) {
 
 /// Per-face labels from their runs, for `triangles` triangles; empty when there was
 /// no label line.
-fn expand_runs(runs: &[LabelRun], triangles: usize) -> Vec<u32> {
+pub(super) fn expand_runs(runs: &[LabelRun], triangles: usize) -> Vec<u32> {
     if runs.is_empty() {
         return Vec::new();
     }
@@ -1265,7 +1265,7 @@ impl Reader {
 }
 
 /// The line's keyword (its first word) and what follows it.
-fn keyword(line: &[u8]) -> (&[u8], &[u8]) {
+pub(super) fn keyword(line: &[u8]) -> (&[u8], &[u8]) {
     let line = text::trim_start(line);
     let end = line
         .iter()
@@ -1310,7 +1310,7 @@ fn split_values<'a>(rest: &'a [u8], ascii: bool, out: &mut [&'a [u8]; 8]) -> usi
 
 /// Whether a face line's corners are all `a[/[b][/c]]` with positive indices of at
 /// most 15 digits (which cannot overflow anything), in one pass over the bytes.
-fn plain_positive_corners(rest: &[u8]) -> bool {
+pub(super) fn plain_positive_corners(rest: &[u8]) -> bool {
     let (mut digits, mut nonzero, mut slashes) = (0u32, false, 0u32);
     for &b in rest {
         match b {

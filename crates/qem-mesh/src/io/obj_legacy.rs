@@ -4,8 +4,8 @@
 #![allow(dead_code)]
 
 use super::text::{self, parse_f64, parse_i64, show, words};
-use std::collections::HashMap;
 
+use super::obj::{expand_runs, keyword, plain_positive_corners, LabelRun, Names};
 use super::{sniff, Format, Location, ReadError, ReadNotes};
 use crate::attributes::{Channel, ChannelKind, FaceLabels};
 use crate::{IndexedMesh, InputError};
@@ -16,15 +16,6 @@ struct Counts {
     v: usize,
     vt: usize,
     vn: usize,
-}
-
-fn keyword(line: &[u8]) -> (&[u8], &[u8]) {
-    let line = text::trim_start(line);
-    let end = line
-        .iter()
-        .position(|b| b.is_ascii_whitespace())
-        .unwrap_or(line.len());
-    (&line[..end], &line[end..])
 }
 
 /// What the first scan found besides errors: the lines to blank before `tobj` sees
@@ -43,37 +34,6 @@ struct Scan {
     /// Which triangle corners have no `vt` or `vn` index ([`Slots`]).
     slots: Slots,
     notes: ReadNotes,
-}
-
-/// Distinct names in order of first appearance (the maps answer "seen, and where?").
-#[derive(Default)]
-struct Names {
-    groups: Vec<Vec<u8>>,
-    materials: Vec<Vec<u8>>,
-    libraries: Vec<Vec<u8>>,
-    seen: [HashMap<Vec<u8>, u32>; 3],
-}
-
-impl Names {
-    /// Adds a name of kind `which` (0 groups, 1 materials, 2 libraries) and returns
-    /// its index, or [`FaceLabels::NONE`] for an empty name.
-    fn add(&mut self, which: usize, name: &[u8]) -> u32 {
-        if name.is_empty() {
-            return FaceLabels::NONE;
-        }
-        if let Some(&i) = self.seen[which].get(name) {
-            return i;
-        }
-        let list = match which {
-            0 => &mut self.groups,
-            1 => &mut self.materials,
-            _ => &mut self.libraries,
-        };
-        let i = list.len() as u32;
-        self.seen[which].insert(name.to_vec(), i);
-        list.push(name.to_vec());
-        i
-    }
 }
 
 /// Which corners of the file's triangles name a texture coordinate and a normal.
@@ -157,33 +117,6 @@ fn corner_slots(corner: &[u8]) -> (bool, bool) {
     let vt = parts.next().is_some_and(|p| !p.is_empty());
     let vn = parts.next().is_some_and(|p| !p.is_empty());
     (vt, vn)
-}
-
-/// Where the group or material changes: from triangle `first` on (in file order),
-/// the faces have `label`.
-#[derive(Clone, Copy)]
-struct LabelRun {
-    first: usize,
-    label: u32,
-}
-
-/// Per-face labels from their runs, for `triangles` triangles; empty when there was
-/// no label line.
-fn expand_runs(runs: &[LabelRun], triangles: usize) -> Vec<u32> {
-    if runs.is_empty() {
-        return Vec::new();
-    }
-    let mut faces = vec![FaceLabels::NONE; triangles];
-    for (i, run) in runs.iter().enumerate() {
-        let end = runs
-            .get(i + 1)
-            .map_or(triangles, |r| r.first)
-            .min(triangles);
-        if let Some(span) = faces.get_mut(run.first.min(end)..end) {
-            span.fill(run.label);
-        }
-    }
-    faces
 }
 
 /// Whether `tobj` refuses this `usemtl` line: it takes the name after the first space
@@ -409,39 +342,6 @@ fn check_f32<'a>(
         }
     }
     Ok(())
-}
-
-/// Whether a face line's corners are all `a[/[b][/c]]` with positive indices of at
-/// most 15 digits (which cannot overflow anything), in one pass over the bytes.
-fn plain_positive_corners(rest: &[u8]) -> bool {
-    let (mut digits, mut nonzero, mut slashes) = (0u32, false, 0u32);
-    for &b in rest {
-        match b {
-            b'0'..=b'9' => {
-                digits += 1;
-                nonzero |= b != b'0';
-                if digits > 15 {
-                    return false;
-                }
-            }
-            b'/' => {
-                // A corner cannot start with "/", an index cannot be 0, at most 2 "/".
-                if (slashes == 0 && digits == 0) || (digits > 0 && !nonzero) || slashes == 2 {
-                    return false;
-                }
-                slashes += 1;
-                (digits, nonzero) = (0, false);
-            }
-            b' ' | b'\t' | b'\r' => {
-                if digits > 0 && !nonzero {
-                    return false;
-                }
-                (digits, nonzero, slashes) = (0, false, 0);
-            }
-            _ => return false,
-        }
-    }
-    digits == 0 || nonzero
 }
 
 /// Checks one `v[/vt[/vn]]` face corner.
