@@ -160,7 +160,7 @@ def simplify(
     placement: Literal["optimal", "endpoint_or_midpoint", "solve_first"] = "optimal",
     weighting: Literal["area", "unweighted"] | float = 0.75,
     quadrics: Literal["sum", "exact"] = "exact",
-    boundary: Literal["free", "locked"] | float = 1.0,
+    boundary: Literal["free", "locked"] | float = 10.0,
     max_normal_angle: float = 90.0,
     min_triangle_quality: float = 0.0,
     orientation_check: bool = True,
@@ -220,7 +220,8 @@ def simplify(
       area + s times the mean face area.
     - ``quadrics``: ``"sum"`` (Garland-Heckbert's Q_a + Q_b) or ``"exact"`` (the union of
       the plane sets: every plane counts once).
-    - ``boundary``: a number w (border constraint planes of weight w; 0 lets borders move,
+    - ``boundary``: a number w (border constraint planes of weight w, default 10; seams
+      get planes of weight 1 when w is above 0; 0 lets borders move,
       though border loops are never pinched or closed unless the run is stuck, see
       ``strict``), ``"free"`` (no planes, no
       loop rule) or ``"locked"`` (border vertices never move).
