@@ -676,18 +676,7 @@ impl Reader {
             return;
         }
         // The check of the numbers, on words split at ASCII whitespace.
-        let mut dtoks: [&[u8]; 8] = [&[]; 8];
-        let (dn, dvals) = if ascii && !rest.contains(&0x0b) {
-            (n, vals)
-        } else {
-            let dn = split_ascii(rest, &mut dtoks);
-            let mut d = [None; 8];
-            for (val, tok) in d.iter_mut().zip(&dtoks).take(dn.min(8)) {
-                *val = parse_f64(tok);
-            }
-            toks = dtoks;
-            (dn, d)
-        };
+        let (dn, dvals) = ascii_numbers(rest, ascii, (n, vals), &mut toks, 8);
         let key = (no, 0, 0);
         for k in 0..dn.min(3) {
             if dvals[k].is_none() {
@@ -792,18 +781,7 @@ impl Reader {
         if self.first_d.is_some() {
             return;
         }
-        let mut dtoks: [&[u8]; 8] = [&[]; 8];
-        let (dn, dvals) = if ascii && !rest.contains(&0x0b) {
-            (n, vals)
-        } else {
-            let dn = split_ascii(rest, &mut dtoks);
-            let mut d = [None; 3];
-            for (val, tok) in d.iter_mut().zip(&dtoks).take(dn.min(dim)) {
-                *val = parse_f64(tok);
-            }
-            toks = dtoks;
-            (dn, d)
-        };
+        let (dn, dvals) = ascii_numbers(rest, ascii, (n, vals), &mut toks, dim);
         let key = (no, 0, 0);
         for k in 0..dn.min(dim) {
             if dvals[k].is_none() {
@@ -1262,6 +1240,30 @@ impl Reader {
         mesh.attributes.material_libraries = names.libraries;
         mesh
     }
+}
+
+/// The words of `rest` split at ASCII whitespace (into `toks`) and the first `take` of
+/// them (at most `N`) read as numbers, with their count: `split`, the count and numbers
+/// of the split already made, when that split was the same (an ASCII line without a
+/// vertical tab). The numbers are checked on these words, as the reader before
+/// streaming split them.
+fn ascii_numbers<'a, const N: usize>(
+    rest: &'a [u8],
+    ascii: bool,
+    split: (usize, [Option<f64>; N]),
+    toks: &mut [&'a [u8]; 8],
+    take: usize,
+) -> (usize, [Option<f64>; N]) {
+    if ascii && !rest.contains(&0x0b) {
+        return split;
+    }
+    *toks = [&[]; 8];
+    let n = split_ascii(rest, toks);
+    let mut vals = [None; N];
+    for (val, tok) in vals.iter_mut().zip(toks.iter()).take(n.min(take)) {
+        *val = parse_f64(tok);
+    }
+    (n, vals)
 }
 
 /// The line's keyword (its first word) and what follows it.
