@@ -47,8 +47,8 @@ pub enum VirtualPairsFlag {
 /// How to simplify: target, error bound, virtual pairs, quality controls.
 #[derive(Args, Debug, Clone)]
 pub struct SimplifyFlags {
-    /// Target as a fraction of the input's triangles (as loaded), in (0, 1]
-    /// [default: 0.5 when --triangles is not given].
+    /// Target as a fraction of the input's triangles (as loaded), in (0, 1], rounded to
+    /// the nearest count and at least 1 [default: 0.5 when --triangles is not given].
     #[arg(long, conflicts_with = "triangles", value_parser = parse_ratio)]
     pub ratio: Option<f64>,
     /// Target as a triangle count [default: none, --ratio 0.5 applies].

@@ -19,7 +19,7 @@ fn simplify_spot(name: &str) -> (qem_mesh::IndexedMesh, serde_json::Value) {
 #[test]
 fn spot_keeps_its_uvs_in_obj_and_the_report_says_so() {
     let (mesh, json) = simplify_spot("spot-10.obj");
-    assert!(mesh.triangle_count() <= 585);
+    assert!(mesh.triangle_count() <= 586); // the count nearest 10% of 5,856
     let uv = mesh
         .attributes
         .channel(ChannelKind::TexCoord)

@@ -34,7 +34,11 @@ pub enum Target {
     /// Stop at or below this many triangles.
     Triangles(usize),
     /// Stop at or below this fraction of the input's triangles (as given, before
-    /// cleaning), rounded down.
+    /// cleaning), rounded to the nearest count (1% of 5,856 triangles is 59, the count
+    /// nearest the 58.56 asked), and never below one triangle: the engine keeps a mesh's
+    /// last triangle (it refuses the contraction that would remove it), so a fraction
+    /// of a small mesh that rounds to none asks for that last one (1% of 40 triangles
+    /// is 1).
     Ratio(f64),
     /// No count target: contract until the error bound or until no pair is left.
     None,

@@ -205,7 +205,8 @@ def simplify(
       "solve_first" placement; several times faster, a little less accurate. The other
       options then change that preset.
     - ``ratio`` / ``triangles``: the target, a fraction of the input's triangles (in
-      [0, 1]) or a count; at most one. Default: ratio 0.5.
+      [0, 1], rounded to the nearest count and at least 1) or a count; at most one.
+      Default: ratio 0.5.
     - ``max_error``: stop before the first contraction whose error would exceed this
       distance (a fraction of the bounding-box diagonal, or model units with
       ``absolute``); None = no bound.
