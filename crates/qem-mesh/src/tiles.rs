@@ -30,7 +30,7 @@
 //! Everything is deterministic: the same mesh and tile count give the same tiles, bit
 //! for bit (ties between equal centroid coordinates go by triangle number).
 
-use crate::clean::{clean, coordinate_bits, CleanOptions};
+use crate::clean::{coordinate_bits, weld_in_place};
 use crate::IndexedMesh;
 use rustc_hash::FxHashMap;
 use std::cmp::Ordering;
@@ -66,10 +66,10 @@ impl Tiling {
     /// triangle counts (within one). Attributes are not carried: tiles hold positions
     /// and triangles only.
     ///
-    /// Memory: besides the welded copy of the mesh (24 bytes a vertex, 12 a
-    /// triangle), the cut holds 28 bytes a triangle (its centroid in f64 and its
-    /// number) and the border flags 5 bytes a vertex; the weld itself sorts 32 bytes a
-    /// vertex while the input is still held. `mesh` is expected to have passed
+    /// Memory: besides the mesh (24 bytes a vertex, 12 a triangle), welded in place,
+    /// the weld holds 9 bytes a vertex, the cut 4 bytes a triangle (its number; the
+    /// centroids are computed when compared, not kept) and the border flags 5 bytes a
+    /// vertex. `mesh` is expected to have passed
     /// [`IndexedMesh::validate`]; triangles with an index out of range are dropped
     /// rather than trusted.
     ///
@@ -90,32 +90,14 @@ impl Tiling {
     pub fn new(mut mesh: IndexedMesh, tiles: usize) -> Tiling {
         // Only the exact weld: degenerate and duplicate faces are each tile's
         // simplifier's to drop, as an in-core run drops them after the same weld.
-        let options = CleanOptions::DEFAULT
-            .with_drop_repeated_index(false)
-            .with_drop_zero_area(false)
-            .with_drop_duplicates(false);
-        // Taken by value so the input is dropped once welded: two copies at the peak,
-        // not three. Attributes first: the cleaning would copy their value lists.
-        mesh.attributes = Default::default();
-        let cleaned = clean(&mesh, &options);
-        drop(mesh);
-        Tiling::of_welded(cleaned.mesh, cleaned.report.welded_vertices, tiles)
-    }
-
-    fn of_welded(mesh: IndexedMesh, welded: usize, tiles: usize) -> Tiling {
+        // In place: one mesh at the peak, not the input and its welded copy.
+        let welded = weld_in_place(&mut mesh);
         let count = mesh.triangles.len();
         let tiles = tiles.clamp(1, count.max(1));
-        let centroids: Vec<[f64; 3]> = mesh
-            .triangles
-            .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
-                std::array::from_fn(|k| (a[k] + b[k] + c[k]) / 3.0)
-            })
-            .collect();
+        let centroids = Centroids(&mesh);
         let mut triangles: Vec<u32> = (0..count as u32).collect();
         let mut ends = Vec::with_capacity(tiles);
-        bisect(&mut triangles, 0, tiles, &centroids, &mut ends);
+        bisect(&mut triangles, 0, tiles, centroids, &mut ends);
         let mut starts = Vec::with_capacity(tiles + 1);
         starts.push(0);
         starts.extend_from_slice(&ends);
@@ -124,9 +106,8 @@ impl Tiling {
             let part = &mut triangles[w[0]..w[1]];
             // Input order inside a tile: the file's locality, and one answer.
             part.sort_unstable();
-            boxes.push(bounds(part.iter().map(|&t| centroids[t as usize])));
+            boxes.push(bounds(part.iter().map(|&t| centroids.of(t))));
         }
-        drop(centroids);
         let border = border_flags(&mesh, &triangles, &starts);
         Tiling {
             mesh,
@@ -222,7 +203,7 @@ fn bisect(
     part: &mut [u32],
     offset: usize,
     tiles: usize,
-    centroids: &[[f64; 3]],
+    centroids: Centroids<'_>,
     ends: &mut Vec<usize>,
 ) {
     if tiles <= 1 || part.len() <= 1 {
@@ -234,7 +215,7 @@ fn bisect(
         }
         return;
     }
-    let (min, max) = bounds(part.iter().map(|&t| centroids[t as usize]));
+    let (min, max) = bounds(part.iter().map(|&t| centroids.of(t)));
     // The axis of the largest spread; the first of equals, so the choice is one.
     let axis = (0..3)
         .max_by(|&a, &b| {
@@ -249,8 +230,9 @@ fn bisect(
     // Unique keys (coordinate, then triangle number): the two sides are the same
     // sets whatever the selection algorithm does.
     let key = |&a: &u32, &b: &u32| -> Ordering {
-        centroids[a as usize][axis]
-            .total_cmp(&centroids[b as usize][axis])
+        centroids
+            .coordinate(a, axis)
+            .total_cmp(&centroids.coordinate(b, axis))
             .then(a.cmp(&b))
     };
     if cut > 0 && cut < part.len() {
@@ -259,6 +241,26 @@ fn bisect(
     let (left, right) = part.split_at_mut(cut);
     bisect(left, offset, left_tiles, centroids, ends);
     bisect(right, offset + cut, tiles - left_tiles, centroids, ends);
+}
+
+/// The triangles' centroids, computed when asked (a table of them would be 24 bytes a
+/// triangle, twice the triangles themselves). Each coordinate is `(a + b + c) / 3` of
+/// the corners', the same bits however it is asked.
+#[derive(Clone, Copy)]
+struct Centroids<'a>(&'a IndexedMesh);
+
+impl Centroids<'_> {
+    /// Coordinate `axis` of triangle `t`'s centroid.
+    #[inline]
+    fn coordinate(self, t: u32, axis: usize) -> f64 {
+        let [a, b, c] = self.0.triangles[t as usize].map(|i| self.0.positions[i as usize][axis]);
+        (a + b + c) / 3.0
+    }
+
+    /// Triangle `t`'s centroid.
+    fn of(self, t: u32) -> [f64; 3] {
+        std::array::from_fn(|axis| self.coordinate(t, axis))
+    }
 }
 
 /// The box (min, max) of `points`; an empty box (min > max) when there are none.
