@@ -63,7 +63,7 @@ fn decode(data: &[u8]) -> (IndexedMesh, SimplifyOptions, Option<PassesExtra>) {
         (0, x) => Target::Ratio(f64::from(x) / 255.0),
         (1, x) => Target::Triangles(usize::from(x)),
         (2, _) => Target::None,
-        (_, _) => Target::Ratio(0.0),
+        (_, _) => Target::Triangles(0),
     };
     let flags = b.byte();
     let flag = |bit: u8| flags & (1 << bit) != 0;

@@ -213,15 +213,19 @@ fn same_input_same_output_bit_for_bit() {
 
 #[test]
 fn a_target_of_zero_still_leaves_a_valid_mesh() {
-    // A ratio that rounds down to 0 triangles: contraction stops before the last faces
-    // would vanish, so the output keeps at least one triangle.
+    // Contraction stops before the last faces would vanish, so the output keeps at
+    // least one triangle.
     let sphere = uv_sphere([0.0; 3], 1.0, 6, 8);
     let n = sphere.triangle_count();
-    let out = simplify(&sphere, &options(Target::Ratio(0.01))).unwrap();
+    let out = simplify(&sphere, &options(Target::Triangles(0))).unwrap();
     assert_eq!(out.report.target_triangles, 0);
     assert!(out.mesh.triangle_count() >= 1);
     assert_valid(&out.mesh, n);
     assert_eq!(out.report.stop_reason, StopReason::NoValidPair);
+    // A ratio that rounds to no triangle asks for that last one instead.
+    let out = simplify(&sphere, &options(Target::Ratio(0.01))).unwrap();
+    assert_eq!(out.report.target_triangles, 1);
+    assert_valid(&out.mesh, n);
 }
 
 #[test]
