@@ -4,6 +4,8 @@ the tile tests compare with."""
 
 import os
 import subprocess
+import threading
+import time
 from pathlib import Path
 
 import numpy as np
@@ -96,3 +98,27 @@ def assert_valid(vertices, faces):
     p = vertices.astype(np.float64)
     area2 = np.linalg.norm(np.cross(p[b] - p[a], p[c] - p[a]), axis=1)
     assert (area2 > 0).all(), "a zero-area face"
+
+
+def assert_gil_released(work):
+    """Runs `work()` in a thread and checks the main thread kept running Python code
+    meanwhile: with the GIL held through the call it could not run at all."""
+    span = {}
+
+    def timed():
+        span["start"] = time.perf_counter()
+        work()
+        span["end"] = time.perf_counter()
+
+    thread = threading.Thread(target=timed)
+    ticks = []
+    thread.start()
+    while thread.is_alive():
+        ticks.append(time.perf_counter())
+    thread.join()
+    start, end = span["start"], span["end"]
+    assert end - start > 0.05, "the run is too short to tell"
+    # Ticks inside the middle 80% of the call: none could happen with the GIL held.
+    margin = 0.1 * (end - start)
+    inside = [t for t in ticks if start + margin < t < end - margin]
+    assert len(inside) > 100
