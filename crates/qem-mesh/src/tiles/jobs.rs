@@ -27,7 +27,11 @@
 //! per tile, each job writing only its own tile's files, so jobs running at once never
 //! write the same file; two jobs on the same tile write the same bytes, each
 //! atomically. A job is therefore idempotent: run again, or retried by a scheduler, it
-//! leaves the same files.
+//! leaves the same files. It removes only the temporary files of its own tile's killed
+//! writers, since other tiles' writers may be alive on machines whose processes it
+//! cannot see (two jobs of one tile at once on two machines still leave the same
+//! files, but one may fail, having had its unfinished temporary file taken for a killed
+//! writer's).
 //!
 //! Nothing here holds the tiles together in memory except [`merge`], which holds the
 //! simplified mesh it writes; [`split`] reads the input whole (the readers give whole

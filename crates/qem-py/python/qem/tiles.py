@@ -16,8 +16,11 @@ A tile is **done** when its status names this split, this tile's file, the same 
 (a :func:`fingerprint`) and qem version, and a simplified file of the recorded size and
 CRC-32; anything else (a job killed before its status, a file cut short or changed,
 other options) is simplified again, to the same bytes. So a job is idempotent: run
-twice, or retried by a scheduler, or run at once on two machines, it leaves the same
-files. Each tile job writes only its own tile's files.
+twice, retried by a scheduler, or run twice at once, it leaves the same files. Each tile
+job writes only its own tile's files, and removes only the leftovers of its own tile's
+killed writers. (Two jobs of one tile at once on two machines still leave the same
+files, but one of them may fail: the other can take its unfinished temporary file,
+whose writer no process table on that machine lists, for a killed writer's.)
 
 Every call releases the GIL while qem works. Errors are :class:`qem.QemError` naming the
 file, and say which call fixes them (``qem.tiles.simplify(directory, tile=3, ...)``).
@@ -178,9 +181,8 @@ def simplify(directory, tile=None, **options):
     keep (a ``QemError``). A tile whose locked vertices leave little room for its target
     gets a ``UserWarning`` (split into fewer, larger tiles, or use a higher ratio).
 
-    Idempotent: a task that runs this twice, or on two machines at once, leaves the same
-    bytes. This is the function :func:`qem.distributed.simplify_file` maps over the
-    tiles.
+    Idempotent: a task that runs this twice, or twice at once, leaves the same bytes.
+    This is the function :func:`qem.distributed.simplify_file` maps over the tiles.
     """
     return tiles_simplify(directory, tile, **options)
 
