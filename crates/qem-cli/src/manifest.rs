@@ -12,15 +12,17 @@
 //!
 //! A record counts for `--resume` only when everything it names still holds: the same
 //! input path, size and modification time, the same output path, an output file of
-//! the recorded size and CRC-32, and the same options and qem version (a fingerprint).
+//! the recorded size and CRC-32, and the same options and qem version (a fingerprint;
+//! the stamp and the fingerprint are `qem_mesh::io`'s, which the tile jobs use too).
 //! Anything else (a record lost, a changed input, a touched output) means the input
 //! is simply run again; since every output is written atomically and deterministically,
 //! running it again gives the same bytes.
 
+pub use qem_mesh::io::{fingerprint, OutputStamp};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::fs::File;
-use std::io::{BufRead, Read, Write};
+use std::io::{BufRead, Write};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
@@ -61,43 +63,6 @@ impl InputStamp {
     }
 }
 
-/// What a complete output is: its size and the CRC-32 of its bytes.
-#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq)]
-pub struct OutputStamp {
-    size: u64,
-    crc32: u32,
-}
-
-impl OutputStamp {
-    /// The stamp of a file holding `bytes`.
-    pub fn of_bytes(bytes: &[u8]) -> OutputStamp {
-        OutputStamp {
-            size: bytes.len() as u64,
-            crc32: crc32fast::hash(bytes),
-        }
-    }
-
-    /// Reads `path` through to stamp it; `None` when it cannot be read.
-    pub fn of(path: &Path) -> Option<OutputStamp> {
-        let mut file = File::open(path).ok()?;
-        let mut hasher = crc32fast::Hasher::new();
-        let mut buf = vec![0u8; 1 << 16];
-        let mut size = 0u64;
-        loop {
-            let n = file.read(&mut buf).ok()?;
-            if n == 0 {
-                break;
-            }
-            hasher.update(&buf[..n]);
-            size += n as u64;
-        }
-        Some(OutputStamp {
-            size,
-            crc32: hasher.finalize(),
-        })
-    }
-}
-
 /// One completed input.
 #[derive(Serialize, Deserialize, Clone, Debug)]
 pub struct Record {
@@ -132,14 +97,6 @@ impl Record {
             report,
         })
     }
-}
-
-/// A fingerprint of everything that decides an output's bytes besides its input: the
-/// options (their `Debug` form holds every field), the output format and qem's
-/// version, as a CRC-32 in hex.
-pub fn fingerprint(options: &impl std::fmt::Debug, format: &impl std::fmt::Debug) -> String {
-    let text = format!("{options:?}|{format:?}|qem {}", env!("CARGO_PKG_VERSION"));
-    format!("{:08x}", crc32fast::hash(text.as_bytes()))
 }
 
 /// The manifest of one run: the records kept from earlier runs and the open file
@@ -330,21 +287,5 @@ mod tests {
         assert!(m
             .completed("in/a.obj", stamp, &d.join("a.obj"), "opts")
             .is_none());
-    }
-
-    #[test]
-    fn the_fingerprint_changes_with_any_option() {
-        assert_eq!(
-            fingerprint(&(1, 0.5), &"obj"),
-            fingerprint(&(1, 0.5), &"obj")
-        );
-        assert_ne!(
-            fingerprint(&(1, 0.5), &"obj"),
-            fingerprint(&(1, 0.25), &"obj")
-        );
-        assert_ne!(
-            fingerprint(&(1, 0.5), &"obj"),
-            fingerprint(&(1, 0.5), &"ply")
-        );
     }
 }

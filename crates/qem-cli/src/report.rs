@@ -7,7 +7,6 @@ use qem_mesh::io::{unwritable, Format, ReadNotes};
 use qem_mesh::simplify::SimplifyReport;
 use serde::Serialize;
 use std::collections::BTreeMap;
-use std::io::Write;
 use std::path::Path;
 use std::time::Duration;
 
@@ -437,13 +436,8 @@ impl InfoJson {
 
 /// Writes `value` as pretty JSON to `path` through a temporary file in the same
 /// directory (qem's own, so a killed run's is cleaned up by the next), so a failure
-/// never leaves a partial report.
+/// never leaves a partial report: `qem_mesh::io::write_json_atomically`, its error as
+/// the message to print.
 pub fn write_json_atomically(path: &Path, value: &impl Serialize) -> Result<(), String> {
-    qem_mesh::io::write_atomically(path, |file| {
-        let mut out = std::io::BufWriter::new(file);
-        serde_json::to_writer_pretty(&mut out, value)?;
-        out.write_all(b"\n")?;
-        out.flush()
-    })
-    .map_err(|e| e.to_string())
+    qem_mesh::io::write_json_atomically(path, value).map_err(|e| e.to_string())
 }

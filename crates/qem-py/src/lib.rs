@@ -15,6 +15,10 @@
 //! and go as dicts of per-vertex arrays; the `attributes` module turns them into qem's
 //! per-corner channels and back, splitting the output at its seams.
 //!
+//! The tile jobs of `qem tiles` (`tiles_split`, `tiles_simplify`, `tiles_merge`, the
+//! `tiles` module) are the same library calls as the command's, with the GIL released;
+//! `python/qem/tiles.py` and `python/qem/distributed.py` (Dask) build on them.
+//!
 //! The pure-Python part of the package (`python/qem/__init__.py`) re-exports these
 //! functions and adds the trimesh helper; `python/qem/__init__.pyi` has the types.
 
@@ -36,6 +40,7 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 mod attributes;
+mod tiles;
 
 create_exception!(
     qem,
@@ -433,8 +438,14 @@ fn clean_options(value: &Bound<'_, PyAny>) -> PyResult<CleanOptions> {
 ///
 /// Starts from [`SimplifyOptions::FAST`] with `fast=True`, else from
 /// [`SimplifyOptions::DEFAULT`], and applies each argument given through its `with_*`
-/// setter; arguments left out keep the preset's value.
-fn simplify_options(options: Option<&Bound<'_, PyDict>>) -> PyResult<SimplifyOptions> {
+/// setter; arguments left out keep the preset's value. An unknown keyword is a
+/// `TypeError` naming `function` and listing its arguments: `also` (those it takes
+/// besides the options) and the options.
+fn simplify_options(
+    options: Option<&Bound<'_, PyDict>>,
+    function: &str,
+    also: &[&str],
+) -> PyResult<SimplifyOptions> {
     let Some(options) = options else {
         return Ok(SimplifyOptions::DEFAULT);
     };
@@ -569,9 +580,9 @@ fn simplify_options(options: Option<&Bound<'_, PyDict>>) -> PyResult<SimplifyOpt
             }),
             _ => {
                 return Err(PyTypeError::new_err(format!(
-                    "simplify() got an unexpected keyword argument '{key}'; the options are \
-                     progress, attributes, {}",
-                    OPTION_NAMES.join(", ")
+                    "{function} got an unexpected keyword argument '{key}'; the options are \
+                     {}",
+                    [also, OPTION_NAMES].concat().join(", ")
                 )))
             }
         };
@@ -874,7 +885,7 @@ fn simplify<'py>(
     attributes: Option<&Bound<'py, PyAny>>,
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyTuple>> {
-    let options = simplify_options(options)?;
+    let options = simplify_options(options, "simplify()", &["progress", "attributes"])?;
     let (positions, float_kind) = read_vertices(vertices, "vertices")?;
     let (triangles, index_kind) = read_faces(faces, positions.len(), "faces")?;
     let attributes = attributes
@@ -1055,7 +1066,8 @@ fn save(py: Python<'_>, path: PathBuf, mesh: &Bound<'_, PyAny>) -> PyResult<()> 
         .map_err(|e| qem_error(e.to_string()))
 }
 
-/// The extension module; `qem/__init__.py` re-exports everything in it.
+/// The extension module; `qem/__init__.py` re-exports everything in it but the
+/// `tiles_*` functions, which `qem/tiles.py` wraps.
 #[pymodule]
 fn _qem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("QemError", m.py().get_type::<QemError>())?;
@@ -1065,5 +1077,9 @@ fn _qem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(measure, m)?)?;
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(save, m)?)?;
+    m.add_function(wrap_pyfunction!(tiles::tiles_split, m)?)?;
+    m.add_function(wrap_pyfunction!(tiles::tiles_simplify, m)?)?;
+    m.add_function(wrap_pyfunction!(tiles::tiles_merge, m)?)?;
+    m.add_function(wrap_pyfunction!(tiles::tiles_fingerprint, m)?)?;
     Ok(())
 }

@@ -1,11 +1,51 @@
-"""Shared meshes for the qem tests: small, made here, so the suite needs no files."""
+"""Shared meshes for the qem tests: small, made here, so the suite needs no files (but
+the tile tests, which cut the repository's cow, assets/spot.obj), and the qem command
+the tile tests compare with."""
 
+import os
+import subprocess
+import threading
+import time
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 REPO = Path(__file__).resolve().parents[3]
+
+SPOT = REPO / "assets" / "spot.obj"
+"""The cow: 5,856 triangles, closed, with UVs and normals."""
+
+
+def qem_command():
+    """The qem command of this checkout: CARGO_TARGET_DIR/debug/qem (relative to the
+    repository when relative; target/ when unset), which `cargo test --workspace` builds
+    before .ci/run runs pytest. Fails (not skips) when it is missing: the tile tests
+    exist to show the Python package writes the command's bytes."""
+    target = Path(os.environ.get("CARGO_TARGET_DIR") or "target")
+    if not target.is_absolute():
+        target = REPO / target
+    exe = target / "debug" / ("qem.exe" if os.name == "nt" else "qem")
+    if not exe.is_file():
+        pytest.fail(
+            f"the qem command is not built: no {exe}. The tile tests compare the Python "
+            "package's files with the command's; build it first with "
+            "`cargo build -p qem-cli` (.ci/run's `cargo test --workspace` does)."
+        )
+    return exe
+
+
+def run_qem(*args):
+    """Runs the qem command with `args` (paths converted); fails the test if it fails."""
+    cmd = [str(qem_command()), *map(str, args)]
+    done = subprocess.run(cmd, capture_output=True, text=True)
+    assert done.returncode == 0, f"{' '.join(cmd)}: {done.stderr}"
+    return done
+
+
+def files(directory):
+    """Every file of `directory`: name -> bytes."""
+    return {p.name: p.read_bytes() for p in sorted(Path(directory).iterdir())}
 
 
 def uv_sphere(n=48, m=24):
@@ -58,3 +98,27 @@ def assert_valid(vertices, faces):
     p = vertices.astype(np.float64)
     area2 = np.linalg.norm(np.cross(p[b] - p[a], p[c] - p[a]), axis=1)
     assert (area2 > 0).all(), "a zero-area face"
+
+
+def assert_gil_released(work):
+    """Runs `work()` in a thread and checks the main thread kept running Python code
+    meanwhile: with the GIL held through the call it could not run at all."""
+    span = {}
+
+    def timed():
+        span["start"] = time.perf_counter()
+        work()
+        span["end"] = time.perf_counter()
+
+    thread = threading.Thread(target=timed)
+    ticks = []
+    thread.start()
+    while thread.is_alive():
+        ticks.append(time.perf_counter())
+    thread.join()
+    start, end = span["start"], span["end"]
+    assert end - start > 0.05, "the run is too short to tell"
+    # Ticks inside the middle 80% of the call: none could happen with the GIL held.
+    margin = 0.1 * (end - start)
+    inside = [t for t in ticks if start + margin < t < end - margin]
+    assert len(inside) > 100

@@ -37,13 +37,30 @@ def python_blocks(path):
     return re.findall(r"```python\n(.*?)```", path.read_text(), re.S)
 
 
-def test_readme_example_runs(capsys):
-    # The workspace README and the package's README show the same example: run it once,
-    # and make sure the two copies have not drifted apart.
+def readme_blocks():
+    # The workspace README and the package's README show the same examples: they are
+    # run once, and the two copies must not drift apart.
     blocks = python_blocks(REPO / "README.md")
-    assert len(blocks) == 1, "README.md should have one Python example"
+    assert len(blocks) == 2, "README.md should have two Python examples"
     assert python_blocks(REPO / "crates" / "qem-py" / "README.md") == blocks
-    exec(compile(blocks[0], "README.md", "exec"), {})
+    return blocks
+
+
+def test_readme_example_runs(capsys):
+    exec(compile(readme_blocks()[0], "README.md", "exec"), {})
     out = capsys.readouterr().out
     assert "triangles, max error" in out and "(target_reached)" in out
     assert "Hausdorff distance" in out
+
+
+def test_readme_tiles_example_runs(capsys, tmp_path, monkeypatch):
+    # It reads assets/ from the repository's root and writes beside it: run it in a
+    # scratch directory that links to the assets.
+    (tmp_path / "assets").symlink_to(REPO / "assets")
+    monkeypatch.chdir(tmp_path)
+    with pytest.warns(UserWarning, match="tiles carry positions only"):
+        exec(compile(readme_blocks()[1], "README.md", "exec"), {"__name__": "__main__"})
+    assert "4 tiles: 5856 -> " in capsys.readouterr().out
+    assert (tmp_path / "spot-half-dask.ply").read_bytes() == (
+        tmp_path / "spot-half.ply"
+    ).read_bytes()

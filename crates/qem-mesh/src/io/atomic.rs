@@ -7,7 +7,7 @@
 //! writer is gone.
 
 use std::fs::File;
-use std::io::ErrorKind;
+use std::io::{ErrorKind, Write};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, SystemTime};
 
@@ -46,6 +46,28 @@ pub fn write_atomically(
     write: impl FnOnce(&mut File) -> std::io::Result<()>,
 ) -> Result<(), IoError> {
     write_then(path, write, |tmp| std::fs::rename(tmp, path)).map(|_| ())
+}
+
+/// `value` as pretty-printed JSON (two-space indents, fields in declaration order) and
+/// a final newline, written to `path` atomically ([`write_atomically`]). Every JSON
+/// file qem writes (reports, the tile jobs' manifest and statuses) goes through here, so
+/// they share one layout.
+///
+/// ```
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// let dir = tempfile::tempdir()?;
+/// let path = dir.path().join("counts.json");
+/// qem_mesh::io::write_json_atomically(&path, &[1, 2])?;
+/// assert_eq!(std::fs::read_to_string(&path)?, "[\n  1,\n  2\n]\n");
+/// # Ok(()) }
+/// ```
+pub fn write_json_atomically(path: &Path, value: &impl serde::Serialize) -> Result<(), IoError> {
+    write_atomically(path, |file| {
+        let mut out = std::io::BufWriter::new(file);
+        serde_json::to_writer_pretty(&mut out, value)?;
+        out.write_all(b"\n")?;
+        out.flush()
+    })
 }
 
 /// [`write_atomically`], but never over a file that is there: the complete file is
@@ -172,6 +194,12 @@ pub fn directory_of(path: &Path) -> PathBuf {
 /// assert_eq!(temporary_owner(".a.obj.tmp123"), None);
 /// ```
 pub fn temporary_owner(name: &str) -> Option<u32> {
+    temporary_parts(name).map(|(_, pid)| pid)
+}
+
+/// The name of the file a temporary file of qem's is for, and its writer's process id
+/// (`.NAME.qem-tmp-PID-N` gives `NAME` and `PID`).
+fn temporary_parts(name: &str) -> Option<(&str, u32)> {
     let body = name.strip_prefix('.')?;
     // The last marker: NAME itself may contain one.
     let at = body.rfind(TEMP_MARKER)?;
@@ -180,7 +208,7 @@ pub fn temporary_owner(name: &str) -> Option<u32> {
     if at == 0 || !decimal(pid) || !decimal(n) {
         return None;
     }
-    pid.parse().ok()
+    Some((&body[..at], pid.parse().ok()?))
 }
 
 /// Whether process `pid` may still be writing: this process, or a process that
@@ -232,6 +260,30 @@ enum Owner {
 /// # Ok(()) }
 /// ```
 pub fn remove_stale_temporaries(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
+    remove_stale_where(dir, |_| true)
+}
+
+/// [`remove_stale_temporaries`] for the temporary files of writers of `names` only
+/// (file names in `dir`): for a job that writes only those files and shares the
+/// directory with jobs on other machines, whose writers no process table here lists.
+///
+/// ```
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// let dir = tempfile::tempdir()?;
+/// std::fs::write(dir.path().join(".a.ply.qem-tmp-99999999-0"), b"half of a")?;
+/// std::fs::write(dir.path().join(".b.ply.qem-tmp-99999999-0"), b"half of b")?;
+/// let removed = qem_mesh::io::remove_stale_temporaries_of(dir.path(), &["a.ply"])?;
+/// # #[cfg(target_os = "linux")]
+/// assert_eq!(removed, vec![dir.path().join(".a.ply.qem-tmp-99999999-0")]);
+/// assert!(dir.path().join(".b.ply.qem-tmp-99999999-0").exists());
+/// # Ok(()) }
+/// ```
+pub fn remove_stale_temporaries_of(dir: &Path, names: &[&str]) -> std::io::Result<Vec<PathBuf>> {
+    remove_stale_where(dir, |target| names.contains(&target))
+}
+
+/// Removes the stale temporary files of `dir` whose target name passes `wanted`.
+fn remove_stale_where(dir: &Path, wanted: impl Fn(&str) -> bool) -> std::io::Result<Vec<PathBuf>> {
     let entries = match std::fs::read_dir(dir) {
         Ok(entries) => entries,
         Err(e) if e.kind() == ErrorKind::NotFound => return Ok(Vec::new()),
@@ -241,9 +293,12 @@ pub fn remove_stale_temporaries(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
     for entry in entries {
         let entry = entry?;
         let name = entry.file_name();
-        let Some(pid) = name.to_str().and_then(temporary_owner) else {
+        let Some((target, pid)) = name.to_str().and_then(temporary_parts) else {
             continue;
         };
+        if !wanted(target) {
+            continue;
+        }
         // Never follow a link or touch a directory that happens to match the name.
         let Ok(meta) = std::fs::symlink_metadata(entry.path()) else {
             continue;

@@ -65,9 +65,11 @@
 //! # Writing
 //! [`write_to`] writes any format to a `Write`; [`write_path`] writes a file
 //! atomically (a temporary file in the same directory, then a rename), gzipped when the
-//! name ends in `.gz`. [`write_atomically`] is that atomic step for any content, and
-//! [`remove_stale_temporaries`] removes the temporary files of writers that were
-//! killed before their rename.
+//! name ends in `.gz`. [`write_atomically`] is that atomic step for any content
+//! ([`write_json_atomically`] for JSON), and [`remove_stale_temporaries`] removes the
+//! temporary files of writers that were killed before their rename. [`OutputStamp`]
+//! and [`fingerprint`] tell a complete output, made with given options, from one cut
+//! short, changed or made otherwise, for jobs that skip work already done.
 //!
 //! OBJ and OFF are text with coordinates written in Rust's shortest round-trip form,
 //! PLY is `binary_little_endian` with `double` coordinates: all three read back
@@ -104,6 +106,7 @@ pub mod obj;
 mod obj_legacy;
 mod off;
 mod ply;
+mod stamp;
 mod stl;
 mod text;
 
@@ -111,11 +114,13 @@ use std::io::{Read, Write};
 use std::path::Path;
 
 pub use atomic::{
-    directory_of, remove_stale_temporaries, temporary_owner, write_atomically,
-    write_new_atomically, STALE_AGE_WITHOUT_PROC, TEMP_MARKER,
+    directory_of, remove_stale_temporaries, remove_stale_temporaries_of, temporary_owner,
+    write_atomically, write_json_atomically, write_new_atomically, STALE_AGE_WITHOUT_PROC,
+    TEMP_MARKER,
 };
 pub use error::{IoError, Location, ReadError, ReadErrorKind};
 use input::Input;
+pub use stamp::{fingerprint, OutputStamp};
 
 use crate::IndexedMesh;
 

@@ -17,6 +17,10 @@ whole mesh it accepts a ``(vertices, faces)`` pair or any object with ``.vertice
 - :func:`load` / :func:`save` -- OBJ, PLY, STL and OFF files (optionally gzipped).
 - :func:`default_options` -- the defaults of :func:`simplify`'s options.
 - :class:`QemError` -- raised for everything qem refuses (a ``ValueError``).
+- :mod:`qem.tiles` -- the tile pipeline of ``qem tiles`` (split a mesh file into tiles,
+  simplify each, merge), as jobs any scheduler can run.
+- :mod:`qem.distributed` -- those jobs on a Dask cluster (``simplify_file``); imports
+  ``distributed``, so it is not imported here.
 
 The type stubs (``__init__.pyi``) document every option and the ``attributes`` dict.
 """
@@ -31,6 +35,8 @@ from ._qem import (
     simplify,
 )
 
+from . import tiles
+
 __all__ = [
     "QemError",
     "__version__",
@@ -40,6 +46,7 @@ __all__ = [
     "save",
     "simplify",
     "simplify_trimesh",
+    "tiles",
 ]
 
 

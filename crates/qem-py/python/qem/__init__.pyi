@@ -11,6 +11,11 @@ from typing import Any, Callable, Literal, Mapping, Sequence, Tuple, TypedDict, 
 import numpy as np
 import numpy.typing as npt
 
+# The tile pipeline (qem tiles) and its Dask runner are Python modules, typed inline:
+# qem/tiles.py (split, simplify, merge, fingerprint, and the TypedDicts of the manifest,
+# a tile's status and the merge report) and qem/distributed.py (simplify_file).
+from . import tiles as tiles
+
 __version__: str
 
 class QemError(ValueError):

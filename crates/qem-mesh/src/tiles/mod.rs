@@ -3,7 +3,8 @@
 //!
 //! This is the geometry of `qem tiles split | simplify | merge` (and of the
 //! out-of-core and distributed runs built on it); the files, the manifest and the
-//! bookkeeping of which tile is done live in the command.
+//! bookkeeping of which tile is done are [`jobs`] (feature `io`), which the command and
+//! the Python package both call.
 //!
 //! - [`Tiling::new`] welds the vertices with bit-identical positions (so an STL soup,
 //!   whose facets share no vertex, has its border found by position), and cuts the
@@ -29,6 +30,9 @@
 //!
 //! Everything is deterministic: the same mesh and tile count give the same tiles, bit
 //! for bit (ties between equal centroid coordinates go by triangle number).
+
+#[cfg(feature = "io")]
+pub mod jobs;
 
 use crate::clean::{coordinate_bits, weld_in_place};
 use crate::IndexedMesh;
