@@ -445,7 +445,7 @@ fn run_task(task: &Task, options: &SimplifyOptions) -> Result<SimplifyJson, Stri
         (None, Err(e)) => return Err(format!("{}: {e}", task.input)),
         (None, Ok(_)) => return Err(format!("{}: no output name", task.input)),
     };
-    simplify_file(path, &output, options, &mut CtrlCObserver, true).map_err(|f| match f {
+    simplify_file(path, &output, options, &mut CtrlCObserver, true, None).map_err(|f| match f {
         Failure::Failed(m) | Failure::Usage(m) => m,
         Failure::Interrupted => format!(
             "{}: interrupted (Ctrl-C); nothing was written for it",

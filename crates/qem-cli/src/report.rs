@@ -59,7 +59,68 @@ pub struct SimplifyJson {
     /// (`copied`, `already_there`, `not_copied` with the reason); empty unless the
     /// output is an OBJ with material libraries written to another directory.
     material_files: MaterialFilesJson,
+    /// With `--memory-budget`: the budget, how many triangles it holds in core, and
+    /// the rounds of tiles that ran before the in-core finish (none when the input
+    /// fitted); absent otherwise. After rounds of tiles, `max_error` and the counts
+    /// other than `triangles_in` and `vertices_in` are the finish's, from the merged tiles.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    memory_budget: Option<MemoryBudgetJson>,
     timings_ms: BTreeMap<&'static str, f64>,
+}
+
+/// A run under `--memory-budget` (see [`qem_mesh::tiles::budget`]).
+#[derive(Serialize, Debug, Clone)]
+pub struct MemoryBudgetJson {
+    budget_bytes: u64,
+    in_core_triangles: usize,
+    rounds: Vec<BudgetRoundJson>,
+}
+
+/// One round of tiles of a run under `--memory-budget`.
+#[derive(Serialize, Debug, Clone)]
+pub struct BudgetRoundJson {
+    triangles_in: usize,
+    tiles: usize,
+    tile_ratio: f64,
+    triangles_out: usize,
+    attributes_dropped: bool,
+}
+
+impl MemoryBudgetJson {
+    /// The budget section of `run`'s report.
+    pub fn new(run: &qem_mesh::tiles::budget::BudgetRun) -> Self {
+        MemoryBudgetJson {
+            budget_bytes: run.budget,
+            in_core_triangles: run.room,
+            rounds: run
+                .rounds
+                .iter()
+                .map(|r| BudgetRoundJson {
+                    triangles_in: r.triangles_in,
+                    tiles: r.tiles,
+                    tile_ratio: r.tile_ratio,
+                    triangles_out: r.triangles_out,
+                    attributes_dropped: r.attributes_dropped,
+                })
+                .collect(),
+        }
+    }
+
+    /// `; 2 rounds of tiles (12, 2 tiles)` for the summary line, or nothing.
+    fn summary(&self) -> Option<String> {
+        if self.rounds.is_empty() {
+            return None;
+        }
+        let tiles: Vec<String> = self.rounds.iter().map(|r| r.tiles.to_string()).collect();
+        let (n, s) = (
+            self.rounds.len(),
+            if self.rounds.len() == 1 { "" } else { "s" },
+        );
+        Some(format!(
+            "{n} round{s} of tiles ({} tiles) within the memory budget",
+            tiles.join(", ")
+        ))
+    }
 }
 
 /// What became of the input's attributes (issue 29): `carried` names the channels
@@ -244,8 +305,22 @@ impl SimplifyJson {
             read_notes: notes.into(),
             attributes: AttributesJson::default(),
             material_files: MaterialFilesJson::default(),
+            memory_budget: None,
             timings_ms,
         }
+    }
+
+    /// The report of a run under `--memory-budget`, with the input's counts (the
+    /// finish's own report starts from the merged tiles).
+    pub fn with_memory_budget(
+        mut self,
+        budget: MemoryBudgetJson,
+        (triangles_in, vertices_in): (usize, usize),
+    ) -> Self {
+        self.triangles_in = triangles_in;
+        self.vertices_in = vertices_in;
+        self.memory_budget = Some(budget);
+        self
     }
 
     /// The report with what became of the input's attributes.
@@ -294,11 +369,19 @@ impl SimplifyJson {
                 .collect();
             format!("; relaxed: {}", steps.join(", "))
         };
-        let attributes: String = [self.attributes.summary(), self.material_files.summary()]
-            .into_iter()
-            .flatten()
-            .map(|s| format!("; {s}"))
-            .collect();
+        let budget = self
+            .memory_budget
+            .as_ref()
+            .and_then(MemoryBudgetJson::summary);
+        let attributes: String = [
+            budget,
+            self.attributes.summary(),
+            self.material_files.summary(),
+        ]
+        .into_iter()
+        .flatten()
+        .map(|s| format!("; {s}"))
+        .collect();
         format!(
             "{} → {}: {} → {} triangles, max error {:.4}% of the bounding-box diagonal ({stop}){relaxed}{attributes}",
             self.input,

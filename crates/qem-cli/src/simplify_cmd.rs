@@ -5,13 +5,17 @@ use crate::failure::Failure;
 use crate::materials::{copy_beside, MaterialFilesJson};
 use crate::options::{parse_ratio, SimplifyFlags};
 use crate::progress::{bars_wanted, interrupted, simplify_bar, BarObserver};
-use crate::report::{write_json_atomically, AttributesJson, LevelJson, LevelsJson, SimplifyJson};
+use crate::report::{
+    write_json_atomically, AttributesJson, LevelJson, LevelsJson, MemoryBudgetJson, SimplifyJson,
+};
 use clap::Args;
 use qem_mesh::io::{read_path, write_path, Format, ReadNotes};
 use qem_mesh::simplify::{
     simplify_levels_owned, simplify_owned, Observer, Simplified, SimplifyError, SimplifyOptions,
     StopReason, Target,
 };
+use qem_mesh::tiles::budget::{simplify_within, BudgetError};
+use qem_mesh::tiles::jobs::{SplitInput, TilesError};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -44,9 +48,61 @@ pub struct SimplifyArgs {
     /// [default: no report].
     #[arg(long, value_name = "REPORT.json")]
     pub report: Option<PathBuf>,
+    /// Hold about this much memory at most: an input whose in-core run would need more
+    /// is cut into tiles in a temporary directory, each simplified with its border
+    /// locked, the tiles merged and the merged mesh finished in one piece (attributes
+    /// are then dropped). A size in bytes, or with K, M, G or T (powers of 1024), e.g.
+    /// 500M, 4G [default: no budget].
+    #[arg(long, value_name = "SIZE", value_parser = parse_size, conflicts_with = "lods")]
+    pub memory_budget: Option<u64>,
+    /// Where --memory-budget makes its temporary directory of tiles (removed at the
+    /// end) [default: the output's directory].
+    #[arg(long, value_name = "DIR", requires = "memory_budget")]
+    pub scratch: Option<PathBuf>,
     /// No progress bar and no summary line; errors are still printed [default: off].
     #[arg(short, long)]
     pub quiet: bool,
+}
+
+/// A memory budget for `qem simplify` and where its tiles go.
+#[derive(Clone, Debug)]
+pub struct MemoryBudget {
+    /// The budget in bytes.
+    pub bytes: u64,
+    /// The directory the temporary tile directory is made in.
+    pub scratch: PathBuf,
+}
+
+/// Parses a size: a whole number of bytes, or a number with K, M, G or T (powers of
+/// 1024; a trailing B or iB is allowed: 4G, 4GB and 4GiB are the same).
+pub fn parse_size(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let t = t
+        .strip_suffix("iB")
+        .or_else(|| t.strip_suffix('B'))
+        .unwrap_or(t);
+    let (number, scale) = match t.char_indices().last() {
+        Some((i, c)) if c.is_ascii_alphabetic() => {
+            let power = match c.to_ascii_uppercase() {
+                'K' => 1,
+                'M' => 2,
+                'G' => 3,
+                'T' => 4,
+                _ => return Err(format!("{s}: the unit must be K, M, G or T")),
+            };
+            (&t[..i], 1024f64.powi(power))
+        }
+        _ => (t, 1.0),
+    };
+    let value: f64 = number
+        .trim()
+        .parse()
+        .map_err(|_| format!("{s}: not a size (e.g. 500M, 4G, or a number of bytes)"))?;
+    let bytes = value * scale;
+    if !(bytes >= 1.0 && bytes < 2f64.powi(63)) {
+        return Err(format!("{s}: a size must be at least one byte"));
+    }
+    Ok(bytes as u64)
 }
 
 /// Runs `qem simplify`.
@@ -69,12 +125,20 @@ fn run_single(args: &SimplifyArgs) -> Result<(), Failure> {
     check_output_name(&args.output)?;
     remove_stale_beside(&args.output);
     let bar = simplify_bar(bars_wanted(args.quiet), &file_name(&args.input));
+    let budget = args.memory_budget.map(|bytes| MemoryBudget {
+        bytes,
+        scratch: args
+            .scratch
+            .clone()
+            .unwrap_or_else(|| directory_of(&args.output)),
+    });
     let result = simplify_file(
         &args.input,
         &args.output,
         &args.flags.options()?,
         &mut BarObserver::new(&bar),
         false,
+        budget.as_ref(),
     );
     bar.finish_and_clear();
     let json = result?;
@@ -87,21 +151,48 @@ fn run_single(args: &SimplifyArgs) -> Result<(), Failure> {
     Ok(())
 }
 
-/// Loads `input`, simplifies it and writes `output` atomically; the report names both.
-/// Nothing is written (and with `create_dirs`, no missing directory of `output` is
-/// created) when loading or simplifying fails or Ctrl-C stops the run.
+/// The directory a file is in (`.` for a bare name).
+fn directory_of(path: &Path) -> PathBuf {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// Loads `input`, simplifies it (within `budget`, when given) and writes `output`
+/// atomically; the report names both. Nothing is written (and with `create_dirs`, no
+/// missing directory of `output` is created) when loading or simplifying fails or
+/// Ctrl-C stops the run.
 pub fn simplify_file(
     input: &Path,
     output: &Path,
     options: &SimplifyOptions,
     observer: &mut dyn Observer,
     create_dirs: bool,
+    budget: Option<&MemoryBudget>,
 ) -> Result<SimplifyJson, Failure> {
     let (mesh, notes, load) = load(input)?;
     let input_attributes = AttributesJson::names(&mesh.attributes);
+    let counts_in = (mesh.triangle_count(), mesh.vertex_count());
     let clock = Instant::now();
-    // Handed over: the engine drops it once cleaned (see `simplify_owned`).
-    let result = simplify_owned(mesh, options, observer).map_err(|e| simplify_failure(input, e))?;
+    let (result, budget_json) = match budget {
+        // Handed over: the engine drops it once cleaned (see `simplify_owned`).
+        None => (
+            simplify_owned(mesh, options, observer).map_err(|e| simplify_failure(input, e))?,
+            None,
+        ),
+        Some(budget) => {
+            let split = SplitInput {
+                name: file_name(input),
+                size_bytes: std::fs::metadata(input).map_or(0, |m| m.len()),
+                mesh,
+            };
+            let run = simplify_within(split, options, budget.bytes, &budget.scratch, observer)
+                .map_err(|e| budget_failure(input, e))?;
+            let json = MemoryBudgetJson::new(&run);
+            (run.result, Some(json))
+        }
+    };
     let simplify_time = clock.elapsed();
     if result.report.stop_reason == StopReason::Cancelled || interrupted() {
         return Err(Failure::Interrupted);
@@ -118,7 +209,7 @@ pub fn simplify_file(
         }
     }
     let write = write(output, &result)?;
-    Ok(SimplifyJson::new(
+    let json = SimplifyJson::new(
         input,
         output,
         &result.report,
@@ -128,7 +219,22 @@ pub fn simplify_file(
         write,
     )
     .with_attributes(attributes_of(input_attributes, &result, output))
-    .with_material_files(material_files_of(input, output, &result)))
+    .with_material_files(material_files_of(input, output, &result));
+    Ok(match budget_json {
+        Some(b) => json.with_memory_budget(b, counts_in),
+        None => json,
+    })
+}
+
+/// The failure of a run under a memory budget: as [`simplify_failure`], the tiles'
+/// errors naming their file, the others the input.
+fn budget_failure(input: &Path, e: BudgetError) -> Failure {
+    match e {
+        BudgetError::Simplify(e) => simplify_failure(input, e),
+        BudgetError::Tiles(TilesError::Cancelled) => Failure::Interrupted,
+        e @ (BudgetError::Tiles(_) | BudgetError::Io(_)) => Failure::Failed(e.to_string()),
+        e => Failure::Failed(format!("{}: {e}", input.display())),
+    }
 }
 
 /// The files `result`'s material libraries name, copied beside `output` when it is an
@@ -298,6 +404,20 @@ mod tests {
     use super::*;
     use qem_mesh::simplify::Phase;
 
+    #[test]
+    fn sizes_parse_in_bytes_and_powers_of_1024() {
+        assert_eq!(parse_size("1000"), Ok(1000));
+        assert_eq!(parse_size("500M"), Ok(500 << 20));
+        assert_eq!(parse_size("4G"), Ok(4 << 30));
+        assert_eq!(parse_size("4GB"), Ok(4 << 30));
+        assert_eq!(parse_size("4GiB"), Ok(4 << 30));
+        assert_eq!(parse_size("1.5k"), Ok(1536));
+        assert_eq!(parse_size(" 2T "), Ok(2 << 40));
+        for bad in ["", "M", "4X", "-1G", "0", "NaN", "1e30T", "0.5"] {
+            assert!(parse_size(bad).is_err(), "{bad}");
+        }
+    }
+
     /// Asks to stop as soon as the cleaning ends, as Ctrl-C pressed then would.
     struct StopAfterCleaning(bool);
 
@@ -323,6 +443,7 @@ mod tests {
             &SimplifyOptions::DEFAULT,
             &mut StopAfterCleaning(false),
             false,
+            None,
         );
         assert!(matches!(result, Err(Failure::Interrupted)), "{result:?}");
         assert!(!output.exists());

@@ -224,3 +224,78 @@ fn simplify_removes_stale_temporaries_beside_its_output() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(!stale.exists() && live.exists() && out.exists());
 }
+
+/// `--memory-budget` below what the in-core run needs: the run goes through tiles, the
+/// report says how, the scratch directory is left empty; a budget too small for the
+/// tiles is an error naming the input, with no output written.
+#[test]
+fn a_memory_budget_tiles_a_mesh_that_does_not_fit() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("grid.ply");
+    // 80,000 triangles; 8 MB over the fixed 32 MiB hold about 30,000 in core.
+    qem_mesh::io::write_path(&input, &common::bumpy_grid(200, 1)).unwrap();
+    let scratch = dir.path().join("scratch");
+    std::fs::create_dir(&scratch).unwrap();
+    let out = dir.path().join("out.ply");
+    let report = dir.path().join("report.json");
+    let budget = format!("{}", (32 << 20) + 8_000_000);
+    let o = qem(&[
+        "simplify",
+        common::s(&input),
+        "-o",
+        common::s(&out),
+        "--ratio",
+        "0.02",
+        "--memory-budget",
+        &budget,
+        "--scratch",
+        common::s(&scratch),
+        "--report",
+        common::s(&report),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("1 round of tiles"), "{}", stderr(&o));
+    let json = common::json(&report);
+    assert_eq!(json["triangles_in"], 80_000);
+    assert_eq!(json["triangles_out"], 1_600);
+    let rounds = json["memory_budget"]["rounds"].as_array().unwrap();
+    assert_eq!(rounds.len(), 1);
+    assert!(rounds[0]["tiles"].as_u64().unwrap() >= 3, "{json}");
+    assert_eq!(std::fs::read_dir(&scratch).unwrap().count(), 0);
+    assert_eq!(
+        qem_mesh::io::read_path(&out).unwrap().mesh.triangle_count(),
+        1_600
+    );
+
+    let small = dir.path().join("small.ply");
+    let o = qem(&[
+        "simplify",
+        common::s(&input),
+        "-o",
+        common::s(&small),
+        "--memory-budget",
+        "33M",
+    ]);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("grid.ply: a memory budget of 35 MB is too small"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!small.exists());
+
+    let o = qem(&[
+        "simplify",
+        common::s(&input),
+        "-o",
+        common::s(&small),
+        "--memory-budget",
+        "4X",
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("the unit must be K, M, G or T"),
+        "{}",
+        stderr(&o)
+    );
+}

@@ -267,7 +267,7 @@ fn levels_of(
     let mut results = Vec::with_capacity(levels.len());
     let mut stopped_short: Option<StopReason> = None;
     for &level in levels {
-        let target_triangles = target_count(level, triangles_in);
+        let target_triangles = level.triangles_for(triangles_in);
         let clock = Instant::now();
         observer.phase(Phase::Contracting);
         let stop_reason = match stopped_short {
@@ -367,7 +367,7 @@ fn cluster_levels(
     }
     let mut results = Vec::with_capacity(levels.len());
     for &level in levels {
-        let target_triangles = target_count(level, mesh.triangle_count());
+        let target_triangles = level.triangles_for(mesh.triangle_count());
         let clustered = crate::cluster::cluster(mesh, target_triangles)?;
         let r = clustered.report;
         if clustered.mesh.triangles.is_empty() {
@@ -408,35 +408,4 @@ fn cluster_levels(
         });
     }
     Ok(results)
-}
-
-/// The triangle count a target asks for, given the input's count as loaded.
-fn target_count(target: Target, triangles_in: usize) -> usize {
-    match target {
-        Target::Triangles(n) => n,
-        Target::Ratio(r) if r > 0.0 => ((r.min(1.0) * triangles_in as f64).round() as usize)
-            .clamp(1.min(triangles_in), triangles_in),
-        Target::Ratio(_) => 1.min(triangles_in),
-        Target::None => 0,
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_ratio_asks_for_the_nearest_count_and_never_for_none() {
-        // 585.6 and 58.56 asked: the nearest counts.
-        assert_eq!(target_count(Target::Ratio(0.1), 5856), 586);
-        assert_eq!(target_count(Target::Ratio(0.01), 5856), 59);
-        assert_eq!(target_count(Target::Ratio(0.01), 3427), 34);
-        // 0.4 asked of a 40-triangle mesh: the last triangle, which the engine keeps.
-        assert_eq!(target_count(Target::Ratio(0.01), 40), 1);
-        assert_eq!(target_count(Target::Ratio(0.0), 40), 1);
-        assert_eq!(target_count(Target::Ratio(2.0), 40), 40);
-        assert_eq!(target_count(Target::Ratio(0.5), 0), 0);
-        assert_eq!(target_count(Target::Triangles(0), 40), 0);
-        assert_eq!(target_count(Target::None, 40), 0);
-    }
 }

@@ -44,6 +44,27 @@ pub enum Target {
     None,
 }
 
+impl Target {
+    /// The triangle count this target asks of an input of `triangles_in` triangles (as
+    /// loaded): [`Triangles`](Self::Triangles) as given, [`Ratio`](Self::Ratio) as
+    /// documented there, 0 for [`None`](Self::None).
+    ///
+    /// ```
+    /// use qem_mesh::simplify::Target;
+    /// assert_eq!(Target::Ratio(0.01).triangles_for(5856), 59);
+    /// assert_eq!(Target::Ratio(0.01).triangles_for(40), 1);
+    /// ```
+    pub fn triangles_for(self, triangles_in: usize) -> usize {
+        match self {
+            Target::Triangles(n) => n,
+            Target::Ratio(r) if r > 0.0 => ((r.min(1.0) * triangles_in as f64).round() as usize)
+                .clamp(1.min(triangles_in), triangles_in),
+            Target::Ratio(_) => 1.min(triangles_in),
+            Target::None => 0,
+        }
+    }
+}
+
 /// How the new vertex of a contracted pair is placed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PlacementMode {
@@ -638,5 +659,25 @@ impl SimplifyOptions {
 impl Default for SimplifyOptions {
     fn default() -> Self {
         Self::DEFAULT
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_ratio_asks_for_the_nearest_count_and_never_for_none() {
+        // 585.6 and 58.56 asked: the nearest counts.
+        assert_eq!(Target::Ratio(0.1).triangles_for(5856), 586);
+        assert_eq!(Target::Ratio(0.01).triangles_for(5856), 59);
+        assert_eq!(Target::Ratio(0.01).triangles_for(3427), 34);
+        // 0.4 asked of a 40-triangle mesh: the last triangle, which the engine keeps.
+        assert_eq!(Target::Ratio(0.01).triangles_for(40), 1);
+        assert_eq!(Target::Ratio(0.0).triangles_for(40), 1);
+        assert_eq!(Target::Ratio(2.0).triangles_for(40), 40);
+        assert_eq!(Target::Ratio(0.5).triangles_for(0), 0);
+        assert_eq!(Target::Triangles(0).triangles_for(40), 0);
+        assert_eq!(Target::None.triangles_for(40), 0);
     }
 }

@@ -615,6 +615,55 @@ pub fn split(
     count: TileCount,
     observer: &mut dyn Observer,
 ) -> Result<Manifest, TilesError> {
+    let manifest_path = clear_for_split(dir)?;
+    let size_bytes = std::fs::metadata(input)
+        .map_err(|e| os_error(input, "read", e))?
+        .len();
+    let mesh = read_path(input)?.mesh;
+    if observer.should_stop() {
+        return Err(TilesError::Cancelled);
+    }
+    let name = input
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let input = SplitInput {
+        name,
+        size_bytes,
+        mesh,
+    };
+    write_tiles(input, dir, &manifest_path, count, observer)
+}
+
+/// A mesh to [`split_mesh`], already in memory, with what the manifest says of the file
+/// it came from.
+#[derive(Clone, Debug)]
+pub struct SplitInput {
+    /// The input file's name (without its directory), for [`InputJson::name`].
+    pub name: String,
+    /// The input file's size in bytes, for [`InputJson::size_bytes`].
+    pub size_bytes: u64,
+    /// The mesh, taken over (welded in place and cut: one copy at the peak).
+    pub mesh: IndexedMesh,
+}
+
+/// [`split`] for a mesh already read: the same files as [`split`] of the file it was
+/// read from, given that file's name and size. For a caller that reads the input
+/// anyway (the memory budget of [`super::budget`] decides on it), so it is not read
+/// twice.
+pub fn split_mesh(
+    input: SplitInput,
+    dir: &Path,
+    count: TileCount,
+    observer: &mut dyn Observer,
+) -> Result<Manifest, TilesError> {
+    let manifest_path = clear_for_split(dir)?;
+    write_tiles(input, dir, &manifest_path, count, observer)
+}
+
+/// Creates `dir` if missing and removes its old manifest (and stale temporaries)
+/// before a split; returns the manifest's path.
+fn clear_for_split(dir: &Path) -> Result<PathBuf, TilesError> {
     std::fs::create_dir_all(dir).map_err(|e| os_error(dir, "create", e))?;
     let _ = remove_stale_temporaries(dir);
     let manifest_path = dir.join(MANIFEST_NAME);
@@ -624,19 +673,24 @@ pub fn split(
         }
         _ => {}
     }
-    let size_bytes = std::fs::metadata(input)
-        .map_err(|e| os_error(input, "read", e))?
-        .len();
-    let mesh = read_path(input)?.mesh;
-    if observer.should_stop() {
-        return Err(TilesError::Cancelled);
-    }
+    Ok(manifest_path)
+}
+
+/// The split's work once the input is in memory: the cut, the tiles, the manifest.
+fn write_tiles(
+    input: SplitInput,
+    dir: &Path,
+    manifest_path: &Path,
+    count: TileCount,
+    observer: &mut dyn Observer,
+) -> Result<Manifest, TilesError> {
+    let SplitInput {
+        name,
+        size_bytes,
+        mesh,
+    } = input;
     let triangles = mesh.triangle_count();
     let requested = count.tiles_for(triangles);
-    let name = input
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
     let vertices = mesh.vertex_count();
     let attributes_dropped = !mesh.attributes.is_empty();
     let tiling = Tiling::new(mesh, requested);
@@ -686,7 +740,7 @@ pub fn split(
         tiles,
     };
     manifest.split_id = split_id(&manifest);
-    write_json_atomically(&manifest_path, &manifest)?;
+    write_json_atomically(manifest_path, &manifest)?;
     Ok(manifest)
 }
 

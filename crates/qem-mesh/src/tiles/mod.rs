@@ -32,6 +32,8 @@
 //! for bit (ties between equal centroid coordinates go by triangle number).
 
 #[cfg(feature = "io")]
+pub mod budget;
+#[cfg(feature = "io")]
 pub mod jobs;
 
 use crate::clean::{coordinate_bits, weld_in_place};

@@ -18,6 +18,8 @@ mod attributes_obj;
 #[cfg(feature = "io")]
 mod attributes_ply_off;
 mod attributes_simplify;
+#[cfg(feature = "io")]
+mod budget;
 mod bvh_extremes;
 mod cluster;
 mod exact_quadrics;

@@ -1,0 +1,339 @@
+//! Simplification under a memory budget (`qem simplify --memory-budget`): a mesh whose
+//! in-core run would not fit is cut into tiles on disk, each tile simplified with its
+//! border locked, the tiles merged, and the merged mesh finished in one piece once it
+//! fits.
+//!
+//! The plan, from the measured bytes a triangle of a whole in-core run
+//! ([`IN_CORE_BYTES_PER_TRIANGLE`]):
+//! - `room`: the triangles an in-core run can hold within the budget. A mesh of at most
+//!   `room` triangles is simplified in core, as without a budget.
+//! - Otherwise, a **round**: the mesh is split into tiles of at most `room` triangles
+//!   ([`super::jobs::split_mesh`], in a temporary directory), each tile is simplified
+//!   to the ratio that leaves `keep = max(target, room × MERGED_SHARE)` triangles in
+//!   all, and the tiles are merged. The merged mesh keeps each tile's border strip
+//!   (the locked border vertices and their neighbours), which is why it aims below
+//!   `room`.
+//! - Rounds repeat until the merged mesh fits; then it is simplified in core to the
+//!   target, with no border locked: the old borders' strips are simplified like the
+//!   rest. (A later round cuts the merged mesh anew, so its tiles' borders fall
+//!   elsewhere.)
+//!
+//! Why not tile straight to the target: locked strips take a share of each tile's
+//! budget that grows as the ratio falls, and tiles simplified far below it fold. On
+//! the dragon in 8 tiles, tiles to 10% and then one piece to 1% gave a Hausdorff
+//! distance of 0.384% and a mean of 0.0265% of the diagonal, in-core 0.393% and
+//! 0.0274%; tiles straight to 4% gave 9.8% and 0.41% (BENCHMARKS.md, "Tiles").
+//!
+//! What holds memory at each step, besides the program: the input mesh and the
+//! split's few bytes a triangle (checked against the budget before the split); one
+//! tile's simplification; the merged mesh; the in-core finish. The input's attributes
+//! are not carried by tiles: a run that tiles drops them (the caller is told, in
+//! [`BudgetRun::rounds`]).
+
+use super::jobs::{merge, split_mesh, SplitInput, TileCount, TileDir, TileOptions, TilesError};
+use crate::io::{read_path, IoError};
+use crate::simplify::{
+    simplify_owned, Method, Observer, Simplified, SimplifyError, SimplifyOptions, Target,
+};
+use crate::IndexedMesh;
+use std::path::Path;
+
+/// Bytes a triangle of a whole in-core `qem simplify` process with the contraction
+/// engine, the most measured on a large closed mesh, rounded up: 255 (the defaults),
+/// 183 (`--fast`) and 279 (`--order greedy`) on the versus bench's `sphere:1M` at
+/// ratio 0.01; 220 and 227 with the defaults at 10M and 100M (BENCHMARKS.md,
+/// "Memory budget").
+pub const IN_CORE_BYTES_PER_TRIANGLE: u64 = 280;
+
+/// Bytes a triangle of a whole in-core process with vertex clustering: 45 on
+/// `sphere:1M` at ratio 0.01, rounded up.
+pub const CLUSTER_BYTES_PER_TRIANGLE: u64 = 48;
+
+/// Bytes of a process before its mesh: the program, the readers' and writers'
+/// windows, the threads' stacks (a run on the 5,856-triangle cow peaks near 10 MB).
+pub const FIXED_BYTES: u64 = 32 << 20;
+
+/// What the split holds beside the mesh it cuts (`Tiling::new`'s documentation): the
+/// weld's 9 bytes a vertex, then the cut's 4 bytes a triangle and the border flags' 5
+/// a vertex; and one tile at a time, its mesh and its file (about 48 bytes a tile
+/// triangle). On the bench's 10M-triangle cube-sphere this gives 441 MB; the split
+/// measured 347 MB (BENCHMARKS.md, "Tiles").
+const WELD_BYTES_PER_VERTEX: u64 = 9;
+const CUT_BYTES_PER_TRIANGLE: u64 = 4;
+const BORDER_BYTES_PER_VERTEX: u64 = 5;
+const TILE_COPY_BYTES_PER_TRIANGLE: u64 = 48;
+
+/// The share of `room` a round aims to leave, so that the merged mesh, border strips
+/// and all, still fits.
+const MERGED_SHARE: f64 = 0.8;
+
+/// A budget leaving room for fewer triangles than this in core is refused: the tiles
+/// would be all border.
+const MIN_ROOM: usize = 10_000;
+
+/// At most this many rounds of tiles (each must shrink the mesh; two suffice for any
+/// budget that holds a tenth of the input).
+const MAX_ROUNDS: usize = 8;
+
+/// One round of tiles.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BudgetRound {
+    /// Triangles in the mesh the round cut.
+    pub triangles_in: usize,
+    /// How many tiles.
+    pub tiles: usize,
+    /// The ratio each tile was simplified to.
+    pub tile_ratio: f64,
+    /// Triangles in the merged mesh.
+    pub triangles_out: usize,
+    /// Whether the mesh the round cut carried attributes (which tiles do not keep).
+    pub attributes_dropped: bool,
+}
+
+/// What [`simplify_within`] did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BudgetRun {
+    /// The last, in-core simplification: its mesh is the result. When rounds of tiles
+    /// ran first, its report speaks of the merged mesh it started from
+    /// (`triangles_in`, `max_error`): the tiles' own errors are not in it.
+    pub result: Simplified,
+    /// The rounds of tiles before it, none when the input fitted.
+    pub rounds: Vec<BudgetRound>,
+    /// The budget, in bytes.
+    pub budget: u64,
+    /// The triangles an in-core run can hold within it.
+    pub room: usize,
+    /// The triangle count asked of the input.
+    pub target_triangles: usize,
+}
+
+/// Why [`simplify_within`] failed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum BudgetError {
+    /// The budget cannot hold a step of the run.
+    #[error(
+        "a memory budget of {} is too small for {what}: it needs about {}",
+        megabytes(*budget),
+        megabytes(*needed)
+    )]
+    TooSmall {
+        /// The budget, in bytes.
+        budget: u64,
+        /// About how many bytes the step needs.
+        needed: u64,
+        /// The step.
+        what: &'static str,
+    },
+    /// A tile job failed (a file of the temporary directory, or an option the tiles
+    /// refuse).
+    #[error(transparent)]
+    Tiles(#[from] TilesError),
+    /// Reading a merged mesh back failed.
+    #[error(transparent)]
+    Io(#[from] IoError),
+    /// The in-core simplification failed.
+    #[error(transparent)]
+    Simplify(#[from] SimplifyError),
+    /// A round of tiles did not shrink the mesh (its tiles all border).
+    #[error(
+        "the tiles of {triangles_in} triangles came back with {triangles_out}: \
+         the budget leaves too little room for their borders"
+    )]
+    Stuck {
+        /// Triangles the round cut.
+        triangles_in: usize,
+        /// Triangles it merged.
+        triangles_out: usize,
+    },
+}
+
+fn megabytes(bytes: u64) -> String {
+    format!("{:.0} MB", bytes as f64 / 1e6)
+}
+
+/// Bytes a triangle of an in-core run with `options`.
+fn bytes_per_triangle(options: &SimplifyOptions) -> u64 {
+    match options.method {
+        Method::Clustering => CLUSTER_BYTES_PER_TRIANGLE,
+        _ => IN_CORE_BYTES_PER_TRIANGLE,
+    }
+}
+
+/// About how many bytes a whole in-core run with `options` holds for `triangles`
+/// input triangles (the estimate [`simplify_within`] decides by).
+///
+/// ```
+/// use qem_mesh::simplify::SimplifyOptions;
+/// use qem_mesh::tiles::budget::in_core_bytes;
+/// let ten_million = in_core_bytes(10_000_000, &SimplifyOptions::DEFAULT);
+/// assert!(ten_million > 2_000_000_000 && ten_million < 3_000_000_000);
+/// ```
+pub fn in_core_bytes(triangles: usize, options: &SimplifyOptions) -> u64 {
+    FIXED_BYTES + bytes_per_triangle(options) * triangles as u64
+}
+
+/// Simplifies `input`'s mesh with `options` holding about `budget` bytes at most: in
+/// core when it fits, else in rounds of tiles in a temporary directory made in
+/// `scratch` (removed at the end, whatever the outcome) and an in-core finish (see the
+/// [module docs](self)). The same input, options and budget give the same result, bit
+/// for bit.
+///
+/// The tiles take what [`TileOptions`] takes: a ratio or no target (a count is asked
+/// of the input as a ratio of it), no locked vertices, no virtual pairs; clustering
+/// runs only in core. `observer` sees each tile's and the finish's simplification.
+///
+/// The budget is checked against the estimates above, not against the process's
+/// measured memory: the figures in BENCHMARKS.md ("Memory budget") are the
+/// measurement.
+pub fn simplify_within(
+    input: SplitInput,
+    options: &SimplifyOptions,
+    budget: u64,
+    scratch: &Path,
+    observer: &mut dyn Observer,
+) -> Result<BudgetRun, BudgetError> {
+    let mut mesh = input.mesh;
+    let triangles_in = mesh.triangle_count();
+    let target = options.target.triangles_for(triangles_in);
+    let room = (budget.saturating_sub(FIXED_BYTES) / bytes_per_triangle(options)) as usize;
+    let finish_target = match options.target {
+        Target::None => Target::None,
+        _ => Target::Triangles(target),
+    };
+    let mut rounds: Vec<BudgetRound> = Vec::new();
+    if triangles_in > room {
+        if options.method == Method::Clustering {
+            return Err(BudgetError::TooSmall {
+                budget,
+                needed: in_core_bytes(triangles_in, options),
+                what: "vertex clustering, which runs in one piece",
+            });
+        }
+        if room < MIN_ROOM {
+            return Err(BudgetError::TooSmall {
+                budget,
+                needed: in_core_bytes(MIN_ROOM, options),
+                what: "tiles of at least 10,000 triangles",
+            });
+        }
+        // Checked before any file is written: a tile job refuses the same options.
+        TileOptions::new(options.clone().with_target(Target::Ratio(0.5)))
+            .map_err(TilesError::from)?;
+        let work = tempfile::Builder::new()
+            .prefix(".qem-budget-")
+            .tempdir_in(scratch)
+            .map_err(|source| IoError::File {
+                path: scratch.to_path_buf(),
+                action: "create a temporary directory in",
+                source,
+            })?;
+        let mut name = input.name;
+        let mut size_bytes = input.size_bytes;
+        while mesh.triangle_count() > room {
+            if rounds.len() == MAX_ROUNDS {
+                return Err(BudgetError::Stuck {
+                    triangles_in: mesh.triangle_count(),
+                    triangles_out: mesh.triangle_count(),
+                });
+            }
+            let needed = split_bytes(&mesh, room);
+            if needed > budget {
+                return Err(BudgetError::TooSmall {
+                    budget,
+                    needed,
+                    what: "cutting the mesh into tiles",
+                });
+            }
+            let dir = work.path().join(format!("round-{}", rounds.len() + 1));
+            let round = tile_round(
+                SplitInput {
+                    name: std::mem::take(&mut name),
+                    size_bytes,
+                    mesh,
+                },
+                options,
+                room,
+                target,
+                &dir,
+                observer,
+            )?;
+            let merged_path = dir.join("merged.ply");
+            mesh = read_path(&merged_path)?.mesh;
+            name = "merged.ply".to_string();
+            size_bytes = std::fs::metadata(&merged_path).map_or(0, |m| m.len());
+            // The round's files are not needed again: free the disk as we go.
+            let _ = std::fs::remove_dir_all(&dir);
+            if round.triangles_out >= round.triangles_in {
+                return Err(BudgetError::Stuck {
+                    triangles_in: round.triangles_in,
+                    triangles_out: round.triangles_out,
+                });
+            }
+            rounds.push(round);
+        }
+        drop(work);
+    }
+    let finish = options.clone().with_target(finish_target);
+    Ok(BudgetRun {
+        result: simplify_owned(mesh, &finish, observer)?,
+        rounds,
+        budget,
+        room,
+        target_triangles: target,
+    })
+}
+
+/// About the bytes the split of `mesh` into tiles of at most `room` triangles holds:
+/// the mesh, the weld's or the cut's arrays (the larger), and one tile's copy and file.
+fn split_bytes(mesh: &IndexedMesh, room: usize) -> u64 {
+    let (v, t) = (mesh.vertex_count() as u64, mesh.triangle_count() as u64);
+    let arrays =
+        (WELD_BYTES_PER_VERTEX * v).max(CUT_BYTES_PER_TRIANGLE * t + BORDER_BYTES_PER_VERTEX * v);
+    FIXED_BYTES
+        + 24 * v
+        + 12 * t
+        + attribute_bytes(mesh)
+        + arrays
+        + TILE_COPY_BYTES_PER_TRIANGLE * (room as u64).min(t)
+}
+
+/// The bytes of `mesh`'s attribute channels (values and corners).
+fn attribute_bytes(mesh: &IndexedMesh) -> u64 {
+    let channels = mesh.attributes.channels.iter();
+    channels
+        .map(|c| 4 * c.values.len() as u64 + 12 * c.corners.len() as u64)
+        .sum()
+}
+
+/// One round: `input` split into tiles of at most `room` triangles in `dir`, each
+/// simplified to leave `max(target, room × MERGED_SHARE)` triangles in all, merged
+/// into `dir/merged.ply`.
+fn tile_round(
+    input: SplitInput,
+    options: &SimplifyOptions,
+    room: usize,
+    target: usize,
+    dir: &Path,
+    observer: &mut dyn Observer,
+) -> Result<BudgetRound, BudgetError> {
+    let triangles_in = input.mesh.triangle_count();
+    let attributes_dropped = !input.mesh.attributes.is_empty();
+    let keep = target.max((room as f64 * MERGED_SHARE) as usize);
+    let tile_ratio = keep as f64 / triangles_in as f64;
+    let tile_options = TileOptions::new(options.clone().with_target(Target::Ratio(tile_ratio)))
+        .map_err(TilesError::from)?;
+    split_mesh(input, dir, TileCount::MaxTriangles(room), observer)?;
+    let tiles = TileDir::open(dir)?;
+    for k in 0..tiles.len() {
+        tiles.simplify_tile(k, &tile_options, observer)?;
+    }
+    let merged = merge(dir, &dir.join("merged.ply"), observer)?;
+    Ok(BudgetRound {
+        triangles_in,
+        tiles: tiles.len(),
+        tile_ratio,
+        triangles_out: merged.triangles_out,
+        attributes_dropped,
+    })
+}
