@@ -402,3 +402,71 @@ fn jobs_running_at_once_leave_the_files_of_one_job() {
     }
     assert_eq!(files(&shared), files(&alone));
 }
+
+/// Issue 31's "killed at random points": `qem tiles split` and `qem tiles simplify`
+/// processes killed (SIGKILL) after delays spread over their run, then run again to
+/// the end, leave the same tile directory and merged mesh as one uninterrupted run.
+/// The delays are drawn from a fixed seed; whatever point each kill lands on, the
+/// outcome must be the same, so the test cannot depend on the machine's speed.
+#[test]
+fn jobs_killed_at_random_points_then_rerun_give_the_uninterrupted_output() {
+    let tmp = tempfile::tempdir().expect("a temporary directory");
+    let input = tmp.path().join("grid.ply");
+    // 45,000 triangles: long enough a run to be killed in the middle.
+    write_path(&input, &crate::common::bumpy_grid(150, 2)).expect("write the input");
+    fn run<'a>(input: &'a Path, dir: &'a Path) -> Vec<Vec<&'a str>> {
+        vec![
+            vec!["tiles", "split", s(input), s(dir), "--tiles", "6", "-q"],
+            vec!["tiles", "simplify", s(dir), "--ratio", "0.1", "-q"],
+        ]
+    }
+    let clean_dir = tmp.path().join("uninterrupted");
+    // How long each step takes uninterrupted: the kills land within that.
+    let mut durations = Vec::new();
+    for args in run(&input, &clean_dir) {
+        let clock = std::time::Instant::now();
+        ok(&args);
+        durations.push(clock.elapsed());
+    }
+    let merged = |dir: &Path, name: &str| {
+        let out = tmp.path().join(name);
+        ok(&["tiles", "merge", s(dir), "-o", s(&out), "-q"]);
+        std::fs::read(out).expect("the merged mesh")
+    };
+    let expected = merged(&clean_dir, "uninterrupted.ply");
+
+    let dir = tmp.path().join("killed");
+    let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+    let mut killed = 0;
+    for (args, duration) in run(&input, &dir).into_iter().zip(durations) {
+        for _ in 0..6 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let delay = duration.mul_f64((state % 1000) as f64 / 1000.0);
+            let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_qem"))
+                .args(&args)
+                .stderr(std::process::Stdio::null())
+                .spawn()
+                .expect("qem starts");
+            std::thread::sleep(delay);
+            if child.try_wait().expect("qem's status").is_none() {
+                killed += 1;
+            }
+            let _ = child.kill(); // SIGKILL; it may have finished meanwhile
+            let _ = child.wait();
+        }
+        ok(&args);
+    }
+    // Some kills land in a run (later runs are shorter: they skip the tiles done), so
+    // the reruns had leftovers to deal with.
+    eprintln!("{killed} of 12 kills landed in a run");
+    assert!(killed >= 3, "only {killed} of 12 kills landed in a run");
+    let leftovers: Vec<String> = files(&dir)
+        .into_keys()
+        .filter(|name| !files(&clean_dir).contains_key(name))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+    assert_eq!(files(&dir), files(&clean_dir));
+    assert_eq!(merged(&dir, "killed.ply"), expected);
+}
