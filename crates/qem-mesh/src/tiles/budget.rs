@@ -210,6 +210,13 @@ pub fn simplify_within(
                 what: "vertex clustering, which runs in one piece",
             });
         }
+        if target > room {
+            return Err(BudgetError::TooSmall {
+                budget,
+                needed: in_core_bytes(target, options),
+                what: "the last step, which holds the output's triangles in one piece",
+            });
+        }
         if room < MIN_ROOM {
             return Err(BudgetError::TooSmall {
                 budget,

@@ -108,7 +108,7 @@ fn a_budget_too_small_is_a_clear_error_before_any_file() {
     // Room for 5,000 triangles: tiles would be all border.
     let e = simplify_within(
         input(),
-        &options,
+        &options.clone().with_target(Target::Ratio(0.02)),
         room_for(5_000),
         scratch.path(),
         &mut NoObserver,
@@ -116,6 +116,17 @@ fn a_budget_too_small_is_a_clear_error_before_any_file() {
     .unwrap_err();
     assert!(matches!(e, BudgetError::TooSmall { .. }), "{e}");
     assert!(e.to_string().contains("too small for tiles"), "{e}");
+    // The output must fit in one piece.
+    let most = options.clone().with_target(Target::Ratio(0.5));
+    let e = simplify_within(
+        input(),
+        &most,
+        room_for(20_000),
+        scratch.path(),
+        &mut NoObserver,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("the last step"), "{e}");
     // Clustering runs in one piece only.
     let cluster = SimplifyOptions::CLUSTER.with_target(Target::Ratio(0.1));
     let e = simplify_within(
