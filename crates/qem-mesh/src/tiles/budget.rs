@@ -184,7 +184,7 @@ pub fn in_core_bytes(triangles: usize, options: &SimplifyOptions) -> u64 {
 /// runs only in core. `observer` sees each tile's and the finish's simplification.
 ///
 /// The budget is checked against the estimates above, not against the process's
-/// measured memory: the figures in BENCHMARKS.md ("Memory budget") are the
+/// measured memory: the figures in BENCHMARKS.md ("Under a memory budget") are the
 /// measurement.
 pub fn simplify_within(
     input: SplitInput,
