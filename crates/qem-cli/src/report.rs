@@ -106,7 +106,13 @@ impl MemoryBudgetJson {
         }
     }
 
-    /// `; 2 rounds of tiles (12, 2 tiles)` for the summary line, or nothing.
+    /// Whether rounds of tiles ran (the input did not fit).
+    pub fn tiled(&self) -> bool {
+        !self.rounds.is_empty()
+    }
+
+    /// `2 rounds of tiles (12, 2 tiles) within the memory budget` for the summary
+    /// line, or nothing when the input fitted.
     fn summary(&self) -> Option<String> {
         if self.rounds.is_empty() {
             return None;
@@ -142,8 +148,9 @@ pub struct DroppedJson {
 impl AttributesJson {
     /// What became of the input's attributes (`input`, their names as
     /// [`AttributesJson::names`] gives them) in the simplified mesh's `output`, written
-    /// in `format`.
-    pub fn new(input: Vec<String>, output: &Attributes, format: Format) -> Self {
+    /// in `format`; `lost` is why one the simplification did not keep is missing (only
+    /// vertex clustering and tiles keep positions alone).
+    pub fn new(input: Vec<String>, output: &Attributes, format: Format, lost: &str) -> Self {
         let kept = Self::names(output);
         let not_written = unwritable(output, format);
         let mut json = AttributesJson::default();
@@ -151,7 +158,7 @@ impl AttributesJson {
             if !kept.contains(&what) {
                 json.dropped.push(DroppedJson {
                     what,
-                    reason: "vertex clustering keeps positions only".to_string(),
+                    reason: lost.to_string(),
                 });
             } else if let Some(u) = not_written.iter().find(|u| u.what == what) {
                 json.dropped.push(DroppedJson {

@@ -8,6 +8,7 @@ use crate::progress::{bars_wanted, interrupted, simplify_bar, BarObserver};
 use crate::report::{
     write_json_atomically, AttributesJson, LevelJson, LevelsJson, MemoryBudgetJson, SimplifyJson,
 };
+use crate::tiles_cmd::refused;
 use clap::Args;
 use qem_mesh::io::{read_path, write_path, Format, ReadNotes};
 use qem_mesh::simplify::{
@@ -218,7 +219,16 @@ pub fn simplify_file(
         simplify_time,
         write,
     )
-    .with_attributes(attributes_of(input_attributes, &result, output))
+    .with_attributes(attributes_of(
+        input_attributes,
+        &result,
+        output,
+        if budget_json.as_ref().is_some_and(MemoryBudgetJson::tiled) {
+            "the tiles of --memory-budget keep positions only"
+        } else {
+            CLUSTERING_KEEPS_POSITIONS
+        },
+    ))
     .with_material_files(material_files_of(input, output, &result));
     Ok(match budget_json {
         Some(b) => json.with_memory_budget(b, counts_in),
@@ -232,6 +242,7 @@ fn budget_failure(input: &Path, e: BudgetError) -> Failure {
     match e {
         BudgetError::Simplify(e) => simplify_failure(input, e),
         BudgetError::Tiles(TilesError::Cancelled) => Failure::Interrupted,
+        BudgetError::Tiles(TilesError::Refused(o)) => refused("qem simplify --memory-budget", o),
         e @ (BudgetError::Tiles(_) | BudgetError::Io(_)) => Failure::Failed(e.to_string()),
         e => Failure::Failed(format!("{}: {e}", input.display())),
     }
@@ -248,10 +259,18 @@ fn material_files_of(input: &Path, output: &Path, result: &Simplified) -> Materi
 
 /// What became of the input's attributes (`input`, as [`AttributesJson::names`] gives
 /// them) in `result`, written to `output`.
-fn attributes_of(input: Vec<String>, result: &Simplified, output: &Path) -> AttributesJson {
+/// Why an attribute the simplification did not keep is missing, without tiles.
+const CLUSTERING_KEEPS_POSITIONS: &str = "vertex clustering keeps positions only";
+
+fn attributes_of(
+    input: Vec<String>,
+    result: &Simplified,
+    output: &Path,
+    lost: &str,
+) -> AttributesJson {
     // The output's name was checked before it was written, so it has a format.
     let format = Format::from_path(output).unwrap_or(Format::Obj);
-    AttributesJson::new(input, &result.mesh.attributes, format)
+    AttributesJson::new(input, &result.mesh.attributes, format, lost)
 }
 
 /// The failure of simplifying `input`: Ctrl-C pressed before the loop began is an
@@ -346,7 +365,12 @@ fn run_levels(args: &SimplifyArgs) -> Result<(), Failure> {
             simplify_time,
             write,
         )
-        .with_attributes(attributes_of(input_attributes.clone(), level, output))
+        .with_attributes(attributes_of(
+            input_attributes.clone(),
+            level,
+            output,
+            CLUSTERING_KEEPS_POSITIONS,
+        ))
         .with_material_files(material_files_of(&args.input, output, level));
         if !args.quiet {
             eprintln!("level {lod} (ratio {ratio}): {}", run.summary_line());

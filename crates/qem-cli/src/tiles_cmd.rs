@@ -113,13 +113,14 @@ fn failure(error: TilesError, dir: &Path) -> Failure {
     };
     match error {
         TilesError::Cancelled => Failure::Interrupted,
-        TilesError::Refused(option) => refused(option),
+        TilesError::Refused(option) => refused("qem tiles simplify", option),
         e => Failure::Failed(format!("{e}{remedy}")),
     }
 }
 
-/// The usage error for an option the tiles do not take, named by its flag.
-fn refused(option: RefusedOption) -> Failure {
+/// The usage error for an option the tiles do not take, named by its flag, given to
+/// `command` (`qem tiles simplify`, or `qem simplify --memory-budget`).
+pub(crate) fn refused(command: &str, option: RefusedOption) -> Failure {
     let flag = match option {
         RefusedOption::TriangleTarget => "--triangles",
         RefusedOption::LockedVertices => "--lock",
@@ -128,7 +129,7 @@ fn refused(option: RefusedOption) -> Failure {
         _ => "one of these options",
     };
     Failure::Usage(format!(
-        "qem tiles simplify does not take {flag}: {}",
+        "{command} does not take {flag}: {}",
         option.reason()
     ))
 }
@@ -171,7 +172,7 @@ fn run_simplify(args: &SimplifyTilesArgs) -> Result<(), Failure> {
         Some(_) => Err(RefusedOption::LockedVertices),
         None => TileOptions::new(args.flags.options()?),
     }
-    .map_err(refused)?;
+    .map_err(|o| refused("qem tiles simplify", o))?;
     let dir = &args.dir;
     let tiles = TileDir::open(dir).map_err(|e| failure(e, dir))?;
     for k in tiles.select(args.tile).map_err(|e| failure(e, dir))? {

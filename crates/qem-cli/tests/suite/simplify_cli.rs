@@ -231,9 +231,22 @@ fn simplify_removes_stale_temporaries_beside_its_output() {
 #[test]
 fn a_memory_budget_tiles_a_mesh_that_does_not_fit() {
     let dir = tempfile::tempdir().unwrap();
-    let input = dir.path().join("grid.ply");
-    // 80,000 triangles; 8 MB over the fixed 32 MiB hold about 30,000 in core.
-    qem_mesh::io::write_path(&input, &common::bumpy_grid(200, 1)).unwrap();
+    let input = dir.path().join("grid.obj");
+    // 80,000 triangles with texture coordinates; 8 MB over the fixed 32 MiB hold
+    // about 30,000 in core.
+    let mut grid = common::bumpy_grid(200, 1);
+    let uv: Vec<f32> = grid
+        .positions
+        .iter()
+        .flat_map(|p| [p[0] as f32, p[1] as f32])
+        .collect();
+    let uv = qem_mesh::attributes::Channel::new(
+        qem_mesh::attributes::ChannelKind::TexCoord,
+        uv,
+        grid.triangles.clone(),
+    );
+    grid.attributes.channels.push(uv);
+    qem_mesh::io::write_path(&input, &grid).unwrap();
     let scratch = dir.path().join("scratch");
     std::fs::create_dir(&scratch).unwrap();
     let out = dir.path().join("out.ply");
@@ -257,6 +270,11 @@ fn a_memory_budget_tiles_a_mesh_that_does_not_fit() {
     assert!(stderr(&o).contains("1 round of tiles"), "{}", stderr(&o));
     let json = common::json(&report);
     assert_eq!(json["triangles_in"], 80_000);
+    // The tiles keep positions only, and the report says so, and why.
+    assert_eq!(
+        json["attributes"]["dropped"],
+        serde_json::json!([{"what": "uv", "reason": "the tiles of --memory-budget keep positions only"}])
+    );
     assert_eq!(json["triangles_out"], 1_600);
     let rounds = json["memory_budget"]["rounds"].as_array().unwrap();
     assert_eq!(rounds.len(), 1);
@@ -278,7 +296,7 @@ fn a_memory_budget_tiles_a_mesh_that_does_not_fit() {
     ]);
     assert!(!o.status.success());
     assert!(
-        stderr(&o).contains("grid.ply: a memory budget of 35 MB is too small"),
+        stderr(&o).contains("grid.obj: a memory budget of 35 MB is too small"),
         "{}",
         stderr(&o)
     );
@@ -298,4 +316,25 @@ fn a_memory_budget_tiles_a_mesh_that_does_not_fit() {
         "{}",
         stderr(&o)
     );
+
+    // An option the tiles cannot keep is a usage error naming its flag.
+    let o = qem(&[
+        "simplify",
+        common::s(&input),
+        "-o",
+        common::s(&small),
+        "--ratio",
+        "0.02",
+        "--memory-budget",
+        &budget,
+        "--pair-threshold",
+        "0.01",
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("qem simplify --memory-budget does not take --pair-threshold"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!small.exists());
 }

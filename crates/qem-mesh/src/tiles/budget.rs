@@ -71,8 +71,8 @@ const MERGED_SHARE: f64 = 0.8;
 /// would be all border.
 const MIN_ROOM: usize = 10_000;
 
-/// At most this many rounds of tiles (each must shrink the mesh; two suffice for any
-/// budget that holds a tenth of the input).
+/// At most this many rounds of tiles (each must shrink the mesh, or the run stops as
+/// [`BudgetError::Stuck`]; the runs measured needed one).
 const MAX_ROUNDS: usize = 8;
 
 /// One round of tiles.
@@ -238,10 +238,10 @@ pub fn simplify_within(
         let mut name = input.name;
         let mut size_bytes = input.size_bytes;
         while mesh.triangle_count() > room {
-            if rounds.len() == MAX_ROUNDS {
+            if let Some(last) = rounds.last().filter(|_| rounds.len() == MAX_ROUNDS) {
                 return Err(BudgetError::Stuck {
-                    triangles_in: mesh.triangle_count(),
-                    triangles_out: mesh.triangle_count(),
+                    triangles_in: last.triangles_in,
+                    triangles_out: last.triangles_out,
                 });
             }
             let needed = split_bytes(&mesh, room);
@@ -265,18 +265,18 @@ pub fn simplify_within(
                 &dir,
                 observer,
             )?;
-            let merged_path = dir.join("merged.ply");
-            mesh = read_path(&merged_path)?.mesh;
-            name = "merged.ply".to_string();
-            size_bytes = std::fs::metadata(&merged_path).map_or(0, |m| m.len());
-            // The round's files are not needed again: free the disk as we go.
-            let _ = std::fs::remove_dir_all(&dir);
             if round.triangles_out >= round.triangles_in {
                 return Err(BudgetError::Stuck {
                     triangles_in: round.triangles_in,
                     triangles_out: round.triangles_out,
                 });
             }
+            let merged_path = dir.join("merged.ply");
+            mesh = read_path(&merged_path)?.mesh;
+            name = "merged.ply".to_string();
+            size_bytes = std::fs::metadata(&merged_path).map_or(0, |m| m.len());
+            // The round's files are not needed again: free the disk as we go.
+            let _ = std::fs::remove_dir_all(&dir);
             rounds.push(round);
         }
         drop(work);
