@@ -7,6 +7,7 @@
 //! back for reports: to world units, and to fractions of the bounding-box diagonal (the
 //! Metro convention used in papers).
 
+use crate::Quadric;
 use glam::DVec3;
 
 /// A translation and uniform scale between world coordinates and normalised ones.
@@ -131,5 +132,55 @@ impl Frame {
     /// A normalised squared distance (a quadric cost per unit weight) in world units².
     pub fn squared_to_world(&self, d2: f64) -> f64 {
         d2 * self.scale * self.scale
+    }
+
+    /// A quadric of area-weighted planes in normalised coordinates, in world ones:
+    /// the same planes with world areas for weights and world squared distances for
+    /// errors, `Q_w(x) = s⁴ · Q(to_normalized(x))` for the scale `s`. This is how a
+    /// quadric leaves one run (one frame) for another ([`quadric_to_normalized`]
+    /// brings it into the other's frame): a vertex's quadric carried from a tile of a
+    /// mesh into the run that finishes the whole.
+    ///
+    /// [`quadric_to_normalized`]: Frame::quadric_to_normalized
+    ///
+    /// ```
+    /// use glam::DVec3;
+    /// use qem_core::{Frame, Quadric};
+    /// let f = Frame::from_bounds(DVec3::ZERO, DVec3::new(4.0, 2.0, 2.0));
+    /// // The plane z = 1 (world) is z = 0 normalised; unit weight there is weight 4
+    /// // (2² world area units) in the world.
+    /// let q = Quadric::from_plane(DVec3::Z, 0.0);
+    /// let world = f.quadric_to_world(&q);
+    /// assert_eq!(world.evaluate(DVec3::new(3.0, 0.5, 4.0)), 4.0 * 3.0 * 3.0);
+    /// assert_eq!(f.quadric_to_normalized(&world), q);
+    /// ```
+    pub fn quadric_to_world(&self, q: &Quadric) -> Quadric {
+        rescaled(q, self.scale).translated(self.center)
+    }
+
+    /// A quadric in world coordinates (as [`quadric_to_world`] gives it) in this
+    /// frame's normalised ones: `Q(y) = Q_w(to_world(y)) / s⁴`.
+    ///
+    /// [`quadric_to_world`]: Frame::quadric_to_world
+    pub fn quadric_to_normalized(&self, q: &Quadric) -> Quadric {
+        rescaled(&q.translated(-self.center), 1.0 / self.scale)
+    }
+}
+
+/// `Q'(p) = k⁴ · Q(p / k)`: the same planes in coordinates `k` times larger, with
+/// weights (areas) `k²` times larger.
+fn rescaled(q: &Quadric, k: f64) -> Quadric {
+    let (k2, k3) = (k * k, k * k * k);
+    Quadric {
+        xx: q.xx * k2,
+        xy: q.xy * k2,
+        xz: q.xz * k2,
+        yy: q.yy * k2,
+        yz: q.yz * k2,
+        zz: q.zz * k2,
+        x: q.x * k3,
+        y: q.y * k3,
+        z: q.z * k3,
+        c: q.c * k2 * k2,
     }
 }

@@ -230,9 +230,11 @@ fn bad_directories_are_clear_errors_naming_the_file() {
     split_spot(&dir);
     let manifest = dir.join("tiles.json");
     let text = std::fs::read_to_string(&manifest).expect("the manifest");
+    let other_version = text.replace("\"qem_tiles\": 2", "\"qem_tiles\": 99");
+    assert_ne!(other_version, text, "the manifest names its version, 2");
     for corrupt in [
         "{ not json".to_string(),
-        text.replace("\"qem_tiles\": 1", "\"qem_tiles\": 99"),
+        other_version,
         text.replace("tile-00002.ply", "../../etc/passwd"),
         String::new(),
     ] {

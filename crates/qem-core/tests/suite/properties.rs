@@ -2,8 +2,8 @@
 
 use proptest::prelude::*;
 use qem_core::{
-    minimize, minimize_by_cofactors, optimal_placement, solve_first_placement, DVec3, Quadric,
-    SINGULAR_DETERMINANT_RATIO,
+    minimize, minimize_by_cofactors, optimal_placement, solve_first_placement, DVec3, Frame,
+    Quadric, SINGULAR_DETERMINANT_RATIO,
 };
 
 /// A plane with unit normal, offset and weight, kept explicitly for brute force.
@@ -247,5 +247,30 @@ proptest! {
         let q = Quadric::from_entries(entries);
         let folded = entries.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         prop_assert_eq!(q.magnitude().to_bits(), folded.to_bits());
+    }
+}
+
+proptest! {
+    /// A triangle's area-weighted quadric built in a frame's normalised coordinates
+    /// and taken to the world is the one built from the world corners; and back.
+    #[test]
+    fn a_quadric_taken_to_the_world_is_the_one_built_there(
+        corners in proptest::array::uniform3(point()),
+        lo in point(),
+        extent in (0.01..100.0f64, 0.01..100.0f64, 0.01..100.0f64),
+        p in point(),
+    ) {
+        let hi = lo + DVec3::new(extent.0, extent.1, extent.2);
+        let frame = Frame::from_bounds(lo, hi);
+        let world = corners.map(|c| lo + c.abs() * 0.25 * (hi - lo));
+        let [a, b, c] = world.map(|w| frame.to_normalized(w));
+        let built_in_world = Quadric::from_triangle(world[0], world[1], world[2]);
+        let carried = frame.quadric_to_world(&Quadric::from_triangle(a, b, c));
+        let x = frame.to_world(p);
+        let scale = built_in_world.magnitude() * (1.0 + x.length_squared());
+        prop_assert!((carried.evaluate(x) - built_in_world.evaluate(x)).abs() <= 1e-9 * scale);
+        let back = frame.quadric_to_normalized(&carried);
+        let n_scale = back.magnitude() * (1.0 + p.length_squared());
+        prop_assert!((back.evaluate(p) - Quadric::from_triangle(a, b, c).evaluate(p)).abs() <= 1e-9 * n_scale);
     }
 }

@@ -18,6 +18,7 @@
 //! space-filling curve), so "in order" is also "near in space", whatever order the
 //! input came in; the output and the observer get the cleaned mesh's numbers back.
 
+use super::carried::{gather_in_place, is_carried, CarriedQuadrics};
 use super::checks::{Facing, Rejection};
 use super::counters::Counters;
 use super::incidence::Incidence;
@@ -109,6 +110,9 @@ pub(super) struct Engine {
     /// For each triangle, its number in the cleaned mesh.
     triangle_from: Vec<u32>,
     quadric: Vec<Quadric>,
+    /// At the setup of a seeded run, which vertices' quadrics were carried in (the
+    /// planes the setup sums are in them already); empty otherwise and afterwards.
+    seeded: Vec<bool>,
     locked: Vec<bool>,
     /// Corners of every cleaned input triangle; [`REMOVED`] in the first corner once
     /// the triangle is gone.
@@ -227,17 +231,20 @@ impl Engine {
     /// Face quadrics summed into vertex quadrics, border planes or locks, locked
     /// vertices; `locked` lists cleaned-mesh indices. With the orientation check on,
     /// also its index (built on the other core meanwhile), from which the input faces
-    /// are then read ([`InputFaces`]).
+    /// are then read ([`InputFaces`]). The vertices that have a quadric in `seed` (by
+    /// cleaned-mesh vertex, [`CarriedQuadrics`]) start from it instead of the planes
+    /// around them; the seed becomes the quadric array, so it is never held twice.
     pub fn new(
         cleaned: &IndexedMesh,
         frame: Frame,
         locked: &[u32],
         options: &SimplifyOptions,
+        seed: Option<CarriedQuadrics>,
     ) -> Self {
         // The orientation check's index is independent of the rest of the setup: built
         // on the other core meanwhile (deterministic either way).
         let ((mut engine, area_offset), surface) = rayon::join(
-            || Engine::set_up(cleaned, frame, locked, options),
+            || Engine::set_up(cleaned, frame, locked, options, seed),
             || {
                 options
                     .orientation_check
@@ -259,6 +266,7 @@ impl Engine {
         frame: Frame,
         locked: &[u32],
         options: &SimplifyOptions,
+        seed: Option<CarriedQuadrics>,
     ) -> (Self, Option<f64>) {
         let Renumbered {
             mesh,
@@ -286,8 +294,9 @@ impl Engine {
             vertex_from,
             triangle_from,
             // Summed by `sum_face_planes` (a filled array made first was 80 bytes a
-            // vertex of pages written twice).
+            // vertex of pages written twice), or a seed's (`take_seed`).
             quadric: Vec::new(),
+            seeded: Vec::new(),
             locked: vec![false; n],
             triangles: mesh.triangles,
             live,
@@ -330,6 +339,9 @@ impl Engine {
             wedges: None,
         };
         engine.set_block_vertices(BLOCK_VERTICES);
+        if let Some(seed) = seed {
+            engine.take_seed(seed);
+        }
         // The incident lists first: the quadrics are summed along them.
         engine.list_incident_triangles();
         let area_offset = engine.sum_face_planes(options);
@@ -342,6 +354,7 @@ impl Engine {
             &options.attribute_weights,
         );
         engine.add_seam_planes(options, area_offset);
+        engine.seeded = Vec::new();
         for &i in locked {
             if let Some(&v) = vertex_to.get(i as usize) {
                 engine.locked[v as usize] = true;
@@ -492,19 +505,28 @@ impl Engine {
         // corners rather than once into an array: the array was 40 bytes a triangle at
         // the setup's memory peak, and with the orientation check on nothing keeps it
         // afterwards (`InputFaces` reads the planes from the check's index).
-        let positions = self.positions();
+        // The fields, not `self.positions()`: the seeded case writes `self.quadric`.
+        let positions = Positions::whole(&self.frame, &self.world);
         let (triangles, incidence) = (&self.triangles, &self.incidence);
-        self.quadric = (0..self.world.len() as u32)
-            .into_par_iter()
-            .map(|v| {
-                let mut sum = Quadric::default();
-                for &t in incidence.of(v) {
-                    let [pa, pb, pc] = triangles[t as usize].map(|c| positions.position(c));
-                    sum += weighted_plane(pa, pb, pc, area_offset).quadric();
-                }
-                sum
-            })
-            .collect();
+        let sum = |v: u32| {
+            let mut sum = Quadric::default();
+            for &t in incidence.of(v) {
+                let [pa, pb, pc] = triangles[t as usize].map(|c| positions.position(c));
+                sum += weighted_plane(pa, pb, pc, area_offset).quadric();
+            }
+            sum
+        };
+        if self.seeded.is_empty() {
+            self.quadric = (0..self.world.len() as u32)
+                .into_par_iter()
+                .map(sum)
+                .collect();
+        } else {
+            // A seeded run: only the vertices the seed does not carry.
+            (self.quadric.par_iter_mut().enumerate())
+                .filter(|(_, q)| !is_carried(q))
+                .for_each(|(v, q)| *q = sum(v as u32));
+        }
         area_offset
     }
 
@@ -639,8 +661,11 @@ impl Engine {
             None => w,
         };
         let q = Quadric::boundary_constraint(pa, pb, normal, plane_weight);
-        self.quadric[v as usize] += q;
-        self.quadric[x as usize] += q;
+        for end in [v, x] {
+            if !self.seeded.get(end as usize).is_some_and(|&s| s) {
+                self.quadric[end as usize] += q;
+            }
+        }
         if let Some(exact) = &mut self.exact {
             exact.add_border_plane(v, x, q);
         }
@@ -1034,6 +1059,50 @@ impl Engine {
         in_original_order(mesh, self.vertex_from.len(), &vertex_from, &triangle_from)
     }
 
+    /// Makes `seed` (by cleaned-mesh vertex) the quadric array, in the engine's vertex
+    /// order and frame, in place; [`sum_face_planes`](Self::sum_face_planes) fills the
+    /// vertices it does not carry, and no border or seam plane is added to those it
+    /// does (their quadrics hold them already). A seed of another length than the
+    /// vertices is not taken (a caller's bug: the run then sums every quadric).
+    fn take_seed(&mut self, mut seed: CarriedQuadrics) {
+        debug_assert!(self.exact.is_none(), "a seeded run sums its quadrics");
+        if !gather_in_place(&mut seed, &self.vertex_from) {
+            debug_assert!(
+                false,
+                "a seed of {} for {} vertices",
+                seed.len(),
+                self.world.len()
+            );
+            return;
+        }
+        let frame = self.frame;
+        seed.par_iter_mut()
+            .filter(|q| is_carried(q))
+            .for_each(|q| *q = frame.quadric_to_normalized(q));
+        self.seeded = seed.iter().map(is_carried).collect();
+        self.quadric = seed;
+    }
+
+    /// The quadrics of [`to_mesh`](Self::to_mesh)'s vertices, in its order, in world
+    /// units.
+    pub fn output_quadrics(&self) -> Vec<Quadric> {
+        let mut used = vec![false; self.world.len()];
+        for &t in &self.live {
+            for c in self.triangles[t as usize] {
+                used[c as usize] = true;
+            }
+        }
+        // `to_mesh` orders its vertices by their cleaned-mesh numbers.
+        let mut by_origin: Vec<(u32, u32)> = (0..self.world.len() as u32)
+            .filter(|&v| used[v as usize])
+            .map(|v| (self.vertex_from[v as usize], v))
+            .collect();
+        by_origin.sort_unstable();
+        (by_origin.iter())
+            .map(|&(_, v)| self.frame.quadric_to_world(&self.quadric[v as usize]))
+            .collect()
+    }
+
     /// Live triangles whose normal points more than 90° away from the input triangle's.
     pub fn flipped_faces(&self) -> usize {
         self.live
@@ -1119,7 +1188,7 @@ mod input_faces_tests {
         assert!(n % 7919 != 0, "the step must be prime to the count");
         mesh.triangles = step.iter().map(|&k| mesh.triangles[k]).collect();
         let frame = Frame::from_points(mesh.positions.iter().map(|p| DVec3::from_array(*p)));
-        let engine = Engine::new(&mesh, frame, &[], &SimplifyOptions::default());
+        let engine = Engine::new(&mesh, frame, &[], &SimplifyOptions::default(), None);
         assert!(engine.input_faces.reads_from_index());
         let kept = engine.kept_input_faces(engine.input_faces.area_offset());
         assert!(!kept.reads_from_index());
@@ -1150,7 +1219,7 @@ mod input_faces_tests {
     fn the_last_list_keeps_exactly_the_reusable_costs() {
         let mesh = thin_lens(12, 24);
         let frame = Frame::from_points(mesh.positions.iter().map(|p| DVec3::from_array(*p)));
-        let mut engine = Engine::new(&mesh, frame, &[], &SimplifyOptions::default());
+        let mut engine = Engine::new(&mesh, frame, &[], &SimplifyOptions::default(), None);
         engine.pass = 1;
         engine.list_edges();
         engine.cost_edges();

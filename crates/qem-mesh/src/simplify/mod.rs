@@ -34,6 +34,7 @@
 //! `locality` (the vertex order), `nth_key` (the batch bound), `replay` (the store as
 //! the engine's oracle).
 
+mod carried;
 mod checks;
 mod counters;
 mod engine;
@@ -68,10 +69,15 @@ pub use relaxation::{Constraint, Relaxation, RelaxationStep};
 pub use replay::StoreReplay;
 pub use report::{Refusals, Simplified, SimplifyError, SimplifyReport, StopReason, Timings};
 
+#[cfg(test)]
+pub(crate) use carried::is_carried;
+pub(crate) use carried::{CarriedQuadrics, NOT_CARRIED};
+
 use crate::clean::{clean, CleanOptions, Cleaned};
 use crate::IndexedMesh;
+use carried::by_cleaned_vertex;
 use engine::Engine;
-use qem_core::{DVec3, Frame};
+use qem_core::{DVec3, Frame, Quadric};
 use std::borrow::Cow;
 use std::time::Instant;
 
@@ -141,10 +147,67 @@ pub fn simplify_owned(
     observer: &mut dyn Observer,
 ) -> Result<Simplified, SimplifyError> {
     let triangles_in = mesh.triangle_count();
-    let mut levels = levels_of(Cow::Owned(mesh), options, &[options.target], observer)?;
+    let (mut levels, _) = levels_of(
+        Cow::Owned(mesh),
+        options,
+        &[options.target],
+        observer,
+        Carry::NONE,
+    )?;
     levels
         .pop()
         .ok_or(SimplifyError::NothingLeftAfterCleaning { triangles_in })
+}
+
+/// What a run takes and gives of [`CarriedQuadrics`].
+struct Carry {
+    /// One per input vertex, replacing what the run would sum for it.
+    seed: Option<CarriedQuadrics>,
+    /// Whether the run hands its output vertices' quadrics back.
+    hand_back: bool,
+}
+
+impl Carry {
+    const NONE: Carry = Carry {
+        seed: None,
+        hand_back: false,
+    };
+}
+
+/// [`simplify_owned`] carrying vertex quadrics: `seed` (one per input vertex) replaces
+/// the quadrics the run would sum from the faces, and the result comes with each output
+/// vertex's quadric, in world units. With a seed the quadrics are summed
+/// ([`QuadricMode::Sum`]): the planes behind a carried quadric are not known, so the
+/// planes a pair shares cannot be taken out of its merged quadric. Not with
+/// [`Method::Clustering`], which has no vertex quadrics to hand back (the tiles and the
+/// memory budget refuse it before any run).
+pub(crate) fn simplify_carrying(
+    mesh: IndexedMesh,
+    options: &SimplifyOptions,
+    seed: Option<CarriedQuadrics>,
+    observer: &mut dyn Observer,
+) -> Result<(Simplified, Vec<Quadric>), SimplifyError> {
+    debug_assert_ne!(options.method, Method::Clustering);
+    let triangles_in = mesh.triangle_count();
+    let options = match seed {
+        Some(_) => Cow::Owned(options.clone().with_quadrics(QuadricMode::Sum)),
+        None => Cow::Borrowed(options),
+    };
+    let carry = Carry {
+        seed,
+        hand_back: true,
+    };
+    let (mut levels, mut quadrics) = levels_of(
+        Cow::Owned(mesh),
+        &options,
+        &[options.target],
+        observer,
+        carry,
+    )?;
+    match (levels.pop(), quadrics.pop()) {
+        (Some(level), Some(quadrics)) => Ok((level, quadrics)),
+        _ => Err(SimplifyError::NothingLeftAfterCleaning { triangles_in }),
+    }
 }
 
 /// [`simplify_levels`] for a caller that needs its mesh no more, dropped as soon as
@@ -155,7 +218,7 @@ pub fn simplify_levels_owned(
     levels: &[Target],
     observer: &mut dyn Observer,
 ) -> Result<Vec<Simplified>, SimplifyError> {
-    levels_of(Cow::Owned(mesh), options, levels, observer)
+    levels_of(Cow::Owned(mesh), options, levels, observer, Carry::NONE).map(|(levels, _)| levels)
 }
 
 /// A chain of levels of detail from one run: the loop contracts down to `levels[0]`,
@@ -200,18 +263,20 @@ pub fn simplify_levels(
     levels: &[Target],
     observer: &mut dyn Observer,
 ) -> Result<Vec<Simplified>, SimplifyError> {
-    levels_of(Cow::Borrowed(mesh), options, levels, observer)
+    levels_of(Cow::Borrowed(mesh), options, levels, observer, Carry::NONE).map(|(levels, _)| levels)
 }
 
-/// [`simplify_levels`] on a borrowed or a handed-over mesh.
+/// [`simplify_levels`] on a borrowed or a handed-over mesh, with each level's output
+/// vertices' quadrics when `carry` asks for them (else none).
 fn levels_of(
     mesh: Cow<'_, IndexedMesh>,
     options: &SimplifyOptions,
     levels: &[Target],
     observer: &mut dyn Observer,
-) -> Result<Vec<Simplified>, SimplifyError> {
+    carry: Carry,
+) -> Result<(Vec<Simplified>, Vec<Vec<Quadric>>), SimplifyError> {
     if options.method == Method::Clustering {
-        return cluster_levels(&mesh, options, levels);
+        return Ok((cluster_levels(&mesh, options, levels)?, Vec::new()));
     }
     let mut timings = Timings::default();
     let clock = Instant::now();
@@ -252,7 +317,8 @@ fn levels_of(
     let frame = Frame::from_points(cleaned.mesh.positions.iter().map(|p| DVec3::from_array(*p)));
     let clock = Instant::now();
     observer.phase(Phase::SettingUp);
-    let mut engine = Engine::new(&cleaned.mesh, frame, &locked, options);
+    let seed = carry.seed.map(|seed| by_cleaned_vertex(seed, &cleaned));
+    let mut engine = Engine::new(&cleaned.mesh, frame, &locked, options, seed);
     timings.setup = clock.elapsed();
     if observer.should_stop() {
         return Err(SimplifyError::Cancelled {
@@ -265,6 +331,7 @@ fn levels_of(
     drop(cleaned);
 
     let mut results = Vec::with_capacity(levels.len());
+    let mut quadrics = Vec::new();
     let mut stopped_short: Option<StopReason> = None;
     for &level in levels {
         let target_triangles = level.triangles_for(triangles_in);
@@ -282,6 +349,7 @@ fn levels_of(
         let clock = Instant::now();
         observer.phase(Phase::Compacting);
         let mut raw = engine.to_mesh();
+        let raw_quadrics = carry.hand_back.then(|| engine.output_quadrics());
         // Zero area is judged in the loop's frame, not in the output's own (see
         // `checks::is_zero_area`): the loop refused every contraction that would make a
         // face zero-area, so this drops only faces that came in so (cleaning passes off).
@@ -336,9 +404,18 @@ fn levels_of(
             faces_flipped: engine.flipped_faces(),
             timings,
         };
+        if let Some(raw_quadrics) = raw_quadrics {
+            let mut out_quadrics = vec![Quadric::ZERO; out.vertex_count()];
+            for (&to, q) in final_clean.vertex_map.iter().zip(raw_quadrics) {
+                if to != Cleaned::REMOVED {
+                    out_quadrics[to as usize] += q;
+                }
+            }
+            quadrics.push(out_quadrics);
+        }
         results.push(Simplified { mesh: out, report });
     }
-    Ok(results)
+    Ok((results, quadrics))
 }
 
 /// [`simplify_levels`] with [`Method::Clustering`]: each level clustered from the

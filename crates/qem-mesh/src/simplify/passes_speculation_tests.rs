@@ -104,7 +104,7 @@ pub(super) fn run_levels(
         }
         let frame =
             Frame::from_points(cleaned.mesh.positions.iter().map(|p| DVec3::from_array(*p)));
-        let mut engine = Engine::new(&cleaned.mesh, frame, &locked, options);
+        let mut engine = Engine::new(&cleaned.mesh, frame, &locked, options, None);
         engine.probes.speculate_chunks = setup.speculation;
         if let Some(block_vertices) = setup.block_vertices {
             engine.set_block_vertices(block_vertices);

@@ -14,16 +14,20 @@
 //!   one first.
 //! - `tile-NNNNN.ply` ([`tile_file`]): tile NNNNN, binary PLY with its border vertices
 //!   first (as many as its entry's `border_vertices`).
-//! - `tile-NNNNN.simplified.ply` and `tile-NNNNN.done.json` ([`simplified_file`],
-//!   [`status_file`]): the simplified tile (simplified with its border vertices and
-//!   their neighbours locked, [`Tile::locked_vertices`]; its border vertices first
-//!   again) and its [`TileStatus`], each written atomically, the status after the tile.
+//! - `tile-NNNNN.simplified.ply`, `tile-NNNNN.quadrics` and `tile-NNNNN.done.json`
+//!   ([`simplified_file`], [`quadrics_file`], [`status_file`]): the simplified tile
+//!   (simplified with its border vertices and their neighbours locked,
+//!   [`Tile::locked_vertices`]; its border vertices first again), its vertices'
+//!   quadrics (for a run that goes on from the merged tiles, as
+//!   [`super::budget`]'s does), and its [`TileStatus`], each written atomically, the
+//!   status last.
 //!
 //! **What "done" means.** A tile is done only when its status names this split, this
 //! tile's file (size and CRC-32), the same options (a [`fingerprint`] of them and of
-//! qem's version) and a simplified file of the recorded size and CRC-32. Anything else
-//! (no status: a job killed before it wrote one; a simplified file changed or cut
-//! short; other options) is simplified again, giving the same bytes. One status file
+//! qem's version) and a simplified file and quadrics of the recorded sizes and
+//! CRC-32s. Anything else (no status: a job killed before it wrote one; a simplified
+//! file changed or cut short; other options) is simplified again, giving the same
+//! bytes. One status file
 //! per tile, each job writing only its own tile's files, so jobs running at once never
 //! write the same file; two jobs on the same tile write the same bytes, each
 //! atomically. A job is therefore idempotent: run again, or retried by a scheduler, it
@@ -85,9 +89,11 @@ use crate::io::{
     Format, IoError, OutputStamp,
 };
 use crate::simplify::{
-    simplify_owned, Length, Method, Observer, SimplifyError, SimplifyOptions, StopReason, Target,
+    simplify_carrying, CarriedQuadrics, Length, Method, Observer, SimplifyError, SimplifyOptions,
+    StopReason, Target,
 };
 use crate::{IndexedMesh, InputError};
+use qem_core::Quadric;
 use serde::{Deserialize, Serialize};
 use std::io::{ErrorKind, Write};
 use std::ops::Range;
@@ -97,7 +103,7 @@ use std::path::{Path, PathBuf};
 pub const MANIFEST_NAME: &str = "tiles.json";
 
 /// The manifest's and the statuses' format version; another version is refused.
-const VERSION: u32 = 1;
+const VERSION: u32 = 2;
 
 /// The default of [`TileCount::MaxTriangles`]: a tile's simplification then peaks near
 /// 200 MB (the engine holds about 200 bytes a triangle, BENCHMARKS.md).
@@ -119,6 +125,50 @@ pub fn tile_file(k: usize) -> String {
 /// The name of tile `k`'s simplified file: `tile-NNNNN.simplified.ply`.
 pub fn simplified_file(k: usize) -> String {
     format!("tile-{k:05}.simplified.ply")
+}
+
+/// The name of tile `k`'s quadrics: `tile-NNNNN.quadrics`. Each vertex's quadric of
+/// the simplified tile, in world units ([`qem_core::Frame::quadric_to_world`]): what
+/// its vertex stands for of the tile's input surface. The file is
+/// [`QUADRICS_MAGIC`], the vertex count (a little-endian `u64`), then the ten entries
+/// of each quadric ([`Quadric::entries`], little-endian `f64`s), in the simplified
+/// file's vertex order.
+pub fn quadrics_file(k: usize) -> String {
+    format!("tile-{k:05}.quadrics")
+}
+
+/// The first bytes of a [`quadrics_file`].
+pub const QUADRICS_MAGIC: &[u8; 16] = b"qem quadrics v1\n";
+
+/// The bytes of a [`quadrics_file`] holding `quadrics`.
+fn quadrics_bytes(quadrics: &[Quadric]) -> Vec<u8> {
+    let mut bytes = Vec::with_capacity(24 + 80 * quadrics.len());
+    bytes.extend_from_slice(QUADRICS_MAGIC);
+    bytes.extend_from_slice(&(quadrics.len() as u64).to_le_bytes());
+    for q in quadrics {
+        for e in q.entries() {
+            bytes.extend_from_slice(&e.to_le_bytes());
+        }
+    }
+    bytes
+}
+
+/// The quadrics of a [`quadrics_file`]'s `bytes`, when they hold `vertices` of them
+/// (else `None`).
+fn quadrics_of(bytes: &[u8], vertices: usize) -> Option<Vec<Quadric>> {
+    let rest = bytes.strip_prefix(QUADRICS_MAGIC)?;
+    let (count, entries) = rest.split_first_chunk::<8>()?;
+    if u64::from_le_bytes(*count) != vertices as u64 || entries.len() != 80 * vertices {
+        return None;
+    }
+    let quadrics = entries.chunks_exact(80).map(|quadric| {
+        let mut e = [0.0; 10];
+        for (e, bytes) in e.iter_mut().zip(quadric.chunks_exact(8)) {
+            *e = f64::from_le_bytes(bytes.try_into().expect("chunks of 8"));
+        }
+        Quadric::from_entries(e)
+    });
+    Some(quadrics.collect())
 }
 
 /// The name of tile `k`'s status: `tile-NNNNN.done.json`.
@@ -162,7 +212,7 @@ impl TileCount {
 #[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct Manifest {
-    /// The format version (1).
+    /// The format version (2).
     pub qem_tiles: u32,
     /// A CRC-32 (8 hex digits) of the rest of the manifest: which split a status
     /// belongs to.
@@ -239,7 +289,7 @@ pub struct TileEntry {
 #[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct TileStatus {
-    /// The format version (1).
+    /// The format version (2).
     pub qem_tiles_status: u32,
     /// The split the tile belongs to ([`Manifest::split_id`]).
     pub split_id: String,
@@ -253,6 +303,8 @@ pub struct TileStatus {
     pub output: String,
     /// The simplified file's size and CRC-32.
     pub output_stamp: OutputStamp,
+    /// The quadrics file's size and CRC-32 ([`quadrics_file`]).
+    pub quadrics_stamp: OutputStamp,
     /// The first `border_vertices` vertices of the output are the tile's border ones.
     pub border_vertices: usize,
     /// The tile's triangles.
@@ -439,7 +491,8 @@ pub enum Problem {
         /// The tile.
         tile: usize,
     },
-    /// A simplified file does not match its status (changed or cut short).
+    /// A simplified file or its quadrics do not match its status (changed or cut
+    /// short).
     SimplifiedChanged {
         /// The tile.
         tile: usize,
@@ -962,12 +1015,15 @@ impl TileDir {
 
     /// Tile `k`'s status when it is done for `options` (see the [module docs](self)):
     /// its status belongs to this split, records these options, and the simplified
-    /// file on disk has the recorded size and CRC-32.
+    /// file and quadrics on disk have the recorded sizes and CRC-32s.
     pub fn done(&self, k: usize, options: &TileOptions) -> Option<TileStatus> {
         let status = self.status_of_this_split(k).ok()?;
         let simplified = OutputStamp::of(&self.dir.join(simplified_file(k)));
-        (status.options == options.fingerprint && simplified == Some(status.output_stamp))
-            .then_some(status)
+        let quadrics = OutputStamp::of(&self.dir.join(quadrics_file(k)));
+        (status.options == options.fingerprint
+            && simplified == Some(status.output_stamp)
+            && quadrics == Some(status.quadrics_stamp))
+        .then_some(status)
     }
 
     /// Tile `k`'s work: [`TileWork::Done`] when it is done for `options`, else the tile
@@ -981,7 +1037,10 @@ impl TileDir {
         options: &'a TileOptions,
     ) -> Result<TileWork<'a>, TilesError> {
         self.check_tile(k)?;
-        let _ = remove_stale_temporaries_of(&self.dir, &[&simplified_file(k), &status_file(k)]);
+        let _ = remove_stale_temporaries_of(
+            &self.dir,
+            &[&simplified_file(k), &quadrics_file(k), &status_file(k)],
+        );
         if let Some(status) = self.done(k, options) {
             return Ok(TileWork::Done(status));
         }
@@ -1056,10 +1115,10 @@ impl PendingTile<'_> {
         })
     }
 
-    /// Simplifies the tile with its border locked, then writes the simplified tile and
-    /// then its status (each atomically), and returns the status. `observer` sees the
-    /// simplification; a stop it asks for gives [`TilesError::Cancelled`] and writes
-    /// nothing.
+    /// Simplifies the tile with its border locked, then writes the simplified tile, its
+    /// quadrics and then its status (each atomically), and returns the status.
+    /// `observer` sees the simplification; a stop it asks for gives
+    /// [`TilesError::Cancelled`] and writes nothing.
     pub fn run(self, observer: &mut dyn Observer) -> Result<TileStatus, TilesError> {
         let dir = &self.dir.dir;
         let k = self.k;
@@ -1070,7 +1129,8 @@ impl PendingTile<'_> {
             .options
             .clone()
             .with_locked_vertices(self.locked);
-        let result = simplify_owned(self.tile.mesh, &options, observer).map_err(|e| match e {
+        let simplified = simplify_carrying(self.tile.mesh, &options, None, observer);
+        let (result, quadrics) = simplified.map_err(|e| match e {
             SimplifyError::Cancelled { .. } => TilesError::Cancelled,
             e => TilesError::file(dir.join(tile_file(k)), Problem::Simplify(e)),
         })?;
@@ -1078,10 +1138,16 @@ impl PendingTile<'_> {
             return Err(TilesError::Cancelled);
         }
         let stop_reason = result.report.stop_reason.as_str().to_string();
-        let tile = Tile::border_first(&border_positions, result.mesh);
+        let (tile, new_number) = Tile::border_first_numbered(&border_positions, result.mesh);
+        let mut numbered = vec![Quadric::ZERO; quadrics.len()];
+        for (q, &new) in quadrics.into_iter().zip(&new_number) {
+            numbered[new as usize] = q;
+        }
         let out_path = dir.join(simplified_file(k));
         let out = ply_bytes(&tile.mesh, &out_path)?;
         write_bytes(&out_path, &out)?;
+        let quadrics = quadrics_bytes(&numbered);
+        write_bytes(&dir.join(quadrics_file(k)), &quadrics)?;
         let status = TileStatus {
             qem_tiles_status: VERSION,
             split_id: self.dir.manifest.split_id.clone(),
@@ -1090,6 +1156,7 @@ impl PendingTile<'_> {
             options: self.options.fingerprint.clone(),
             output: simplified_file(k),
             output_stamp: OutputStamp::of_bytes(&out),
+            quadrics_stamp: OutputStamp::of_bytes(&quadrics),
             border_vertices: tile.border_vertices,
             triangles_in,
             triangles_out: tile.mesh.triangle_count(),
@@ -1116,6 +1183,43 @@ pub fn merge(
         path: output.to_path_buf(),
         source,
     })?;
+    let (merged, _, report) = join(dir, Carrying::No, observer)?;
+    merged
+        .validate()
+        .map_err(|e| TilesError::file(output.to_path_buf(), Problem::InvalidMerge(e)))?;
+    let _ = remove_stale_temporaries(&directory_of(output));
+    write_path(output, &merged)?;
+    Ok(report)
+}
+
+/// [`merge`] in memory, with the merged vertices' quadrics read from the tiles'
+/// [`quadrics_file`]s: not carried for a border vertex (its quadric in each tile holds
+/// the planes of the tile's cut, which are not the surface's).
+pub(crate) fn merge_carrying(
+    dir: &Path,
+    observer: &mut dyn Observer,
+) -> Result<(IndexedMesh, CarriedQuadrics, MergeReport), TilesError> {
+    let (merged, carried, report) = join(dir, Carrying::Quadrics, observer)?;
+    merged
+        .validate()
+        .map_err(|e| TilesError::file(dir.to_path_buf(), Problem::InvalidMerge(e)))?;
+    Ok((merged, carried, report))
+}
+
+/// Whether [`join`] reads the tiles' quadrics.
+#[derive(Clone, Copy, PartialEq)]
+enum Carrying {
+    No,
+    Quadrics,
+}
+
+/// The simplified tiles of `dir` joined (see [`merge`]), with their vertices' quadrics
+/// when `carrying` asks for them (else none).
+fn join(
+    dir: &Path,
+    carrying: Carrying,
+    observer: &mut dyn Observer,
+) -> Result<(IndexedMesh, CarriedQuadrics, MergeReport), TilesError> {
     let tiles = TileDir::open(dir)?;
     let mut statuses: Vec<TileStatus> = Vec::with_capacity(tiles.len());
     for k in 0..tiles.len() {
@@ -1131,7 +1235,6 @@ pub fn merge(
         }
         statuses.push(status);
     }
-    let _ = remove_stale_temporaries(&directory_of(output));
     let mut welder = Welder::default();
     for (k, status) in statuses.iter().enumerate() {
         if observer.should_stop() {
@@ -1149,17 +1252,24 @@ pub fn merge(
         if status.border_vertices > mesh.vertex_count() {
             return Err(TilesError::file(path, Problem::FewerVerticesThanBorder));
         }
-        welder.push(&Tile {
-            mesh,
+        let tile = Tile {
             border_vertices: status.border_vertices,
-        });
+            mesh,
+        };
+        if carrying == Carrying::No {
+            welder.push(&tile);
+            continue;
+        }
+        let path = dir.join(quadrics_file(k));
+        let bytes = read_file(&path)?;
+        let quadrics = (OutputStamp::of_bytes(&bytes) == status.quadrics_stamp)
+            .then(|| quadrics_of(&bytes, tile.mesh.vertex_count()))
+            .flatten()
+            .ok_or_else(|| TilesError::file(path, Problem::SimplifiedChanged { tile: k }))?;
+        welder.push_carrying(&tile, &quadrics);
     }
-    let merged = welder.finish();
-    merged
-        .validate()
-        .map_err(|e| TilesError::file(output.to_path_buf(), Problem::InvalidMerge(e)))?;
-    write_path(output, &merged)?;
-    Ok(MergeReport {
+    let (merged, carried) = welder.finish_carrying();
+    let report = MergeReport {
         split_id: tiles.manifest.split_id.clone(),
         options: statuses
             .first()
@@ -1169,13 +1279,14 @@ pub fn merge(
         triangles_in: statuses.iter().map(|s| s.triangles_in).sum(),
         triangles_out: merged.triangle_count(),
         vertices_out: merged.vertex_count(),
-    })
+    };
+    Ok((merged, carried, report))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::simplify::NoObserver;
+    use crate::simplify::{is_carried, NoObserver};
     use std::collections::BTreeMap;
 
     /// An open, bumpy `n` x `n` grid of squares (2 n² triangles) written as PLY.
@@ -1274,6 +1385,67 @@ mod tests {
         assert!(report.triangles_out < 800);
     }
 
+    /// The merge carries each tile's quadrics for its own vertices and none for the
+    /// border vertices (whose quadrics hold the cut's planes); a tile whose quadrics
+    /// file is gone is not done, and its job writes the same file again.
+    #[test]
+    fn merged_quadrics_are_the_tiles_own_and_none_at_their_borders() {
+        let tmp = tempfile::tempdir().expect("a temporary directory");
+        let input = grid_file(tmp.path(), 20);
+        let dir = tmp.path().join("t");
+        split(&input, &dir, TileCount::Tiles(4), &mut NoObserver).expect("split");
+        let tiles = TileDir::open(&dir).expect("open");
+        let options = ratio(0.5);
+        let mut own = Vec::new();
+        let mut border_positions = Vec::new();
+        for k in 0..tiles.len() {
+            let status = tiles
+                .simplify_tile(k, &options, &mut NoObserver)
+                .expect("simplify")
+                .status;
+            let mesh = ply_mesh(
+                &std::fs::read(dir.join(simplified_file(k))).expect("read"),
+                &dir,
+            )
+            .expect("a mesh");
+            let bytes = std::fs::read(dir.join(quadrics_file(k))).expect("read");
+            let quadrics = quadrics_of(&bytes, mesh.vertex_count()).expect("one a vertex");
+            assert!(quadrics
+                .iter()
+                .all(|q| q.entries().iter().all(|e| e.is_finite())));
+            own.extend_from_slice(&quadrics[status.border_vertices..]);
+            border_positions.extend_from_slice(&mesh.positions[..status.border_vertices]);
+        }
+        let (merged, carried, report) = merge_carrying(&dir, &mut NoObserver).expect("merge");
+        assert_eq!(carried.len(), merged.vertex_count());
+        assert_eq!(report.vertices_out, merged.vertex_count());
+        let kept: Vec<Quadric> = carried.iter().copied().filter(is_carried).collect();
+        assert_eq!(kept, own, "the tiles' own vertices' quadrics, in order");
+        for (q, p) in carried.iter().zip(&merged.positions) {
+            assert_eq!(!is_carried(q), border_positions.contains(p));
+        }
+        assert!(carried.len() > kept.len(), "the grid's tiles have borders");
+
+        let path = dir.join(quadrics_file(1));
+        let before = std::fs::read(&path).expect("read");
+        std::fs::remove_file(&path).expect("remove");
+        assert!(tiles.done(1, &options).is_none());
+        let again = tiles
+            .simplify_tile(1, &options, &mut NoObserver)
+            .expect("simplify");
+        assert!(!again.already_done);
+        assert_eq!(std::fs::read(&path).expect("read"), before);
+        // Cut short, it is caught by its stamp.
+        std::fs::write(&path, &before[..before.len() - 8]).expect("write");
+        match merge_carrying(&dir, &mut NoObserver) {
+            Err(TilesError::File { path: p, problem }) => {
+                assert_eq!(p, path);
+                assert_eq!(problem, Problem::SimplifiedChanged { tile: 1 });
+            }
+            other => panic!("not refused: {other:?}"),
+        }
+    }
+
     /// The split id is a fingerprint of the manifest's `Debug` form (type names
     /// included) and qem's version: this pins it, so that renaming a manifest type (or
     /// a change to the cut) cannot go unnoticed; either would leave every existing
@@ -1291,7 +1463,7 @@ mod tests {
         .expect("split");
         assert_eq!(
             (manifest.split_id.as_str(), env!("CARGO_PKG_VERSION")),
-            ("44318c51", "0.1.0"),
+            ("bf6fc3ec", "0.1.0"),
             "a new version changes the split id: update both"
         );
     }

@@ -37,7 +37,9 @@ pub mod budget;
 pub mod jobs;
 
 use crate::clean::{coordinate_bits, weld_in_place};
+use crate::simplify::{CarriedQuadrics, NOT_CARRIED};
 use crate::IndexedMesh;
+use qem_core::Quadric;
 use rustc_hash::FxHashMap;
 use std::cmp::Ordering;
 
@@ -384,6 +386,15 @@ impl Tile {
     /// assert_eq!(tile.mesh.triangles, vec![[2, 0, 1]]);
     /// ```
     pub fn border_first(border: &[[f64; 3]], simplified: IndexedMesh) -> Tile {
+        Tile::border_first_numbered(border, simplified).0
+    }
+
+    /// [`border_first`](Self::border_first), and the new number of each vertex of
+    /// `simplified` (for what goes with its vertices).
+    pub(crate) fn border_first_numbered(
+        border: &[[f64; 3]],
+        simplified: IndexedMesh,
+    ) -> (Tile, Vec<u32>) {
         let mut at: FxHashMap<[u64; 3], u32> = FxHashMap::default();
         at.reserve(simplified.positions.len().min(border.len()));
         // The first vertex at each position, so a duplicate is not taken for it.
@@ -413,10 +424,11 @@ impl Tile {
             .iter()
             .map(|t| t.map(|v| new_of.get(v as usize).copied().unwrap_or(v)))
             .collect();
-        Tile {
+        let tile = Tile {
             mesh: IndexedMesh::new(positions, triangles).with_attributes(simplified.attributes),
             border_vertices,
-        }
+        };
+        (tile, new_of)
     }
 }
 
@@ -443,6 +455,9 @@ impl Tile {
 #[derive(Debug, Default)]
 pub struct Welder {
     mesh: IndexedMesh,
+    /// With [`push_carrying`](Self::push_carrying), each joined vertex's quadric:
+    /// [`NOT_CARRIED`] for a border vertex.
+    carried: CarriedQuadrics,
     /// The joined mesh's vertex at each border position seen so far.
     border: FxHashMap<[u64; 3], u32>,
 }
@@ -475,9 +490,33 @@ impl Welder {
             }));
     }
 
+    /// [`push`](Self::push), and `quadrics` (one per vertex of `tile`, in world units)
+    /// carried for its vertices that are not border ones: a border vertex's quadric is
+    /// left to the run that takes the joined mesh, which sums it from the faces around
+    /// it (see [`budget`]).
+    pub(crate) fn push_carrying(&mut self, tile: &Tile, quadrics: &[Quadric]) {
+        let before = self.mesh.positions.len();
+        self.push(tile);
+        let n = tile.mesh.positions.len();
+        let border = tile.border_vertices.min(n);
+        // `push` appends the tile's border vertices that no earlier tile has, then all
+        // its others, in order.
+        let new_border = self.mesh.positions.len() - before - (n - border);
+        self.carried
+            .extend(std::iter::repeat_n(NOT_CARRIED, new_border));
+        self.carried
+            .extend((border..n).map(|i| quadrics.get(i).copied().unwrap_or(NOT_CARRIED)));
+    }
+
     /// The joined mesh.
     pub fn finish(self) -> IndexedMesh {
         self.mesh
+    }
+
+    /// The joined mesh and its vertices' carried quadrics ([`NOT_CARRIED`] for a
+    /// border vertex), after [`push_carrying`](Self::push_carrying).
+    pub(crate) fn finish_carrying(self) -> (IndexedMesh, CarriedQuadrics) {
+        (self.mesh, self.carried)
     }
 }
 

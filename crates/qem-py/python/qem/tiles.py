@@ -9,12 +9,13 @@ other's work. In the directory:
 
 - ``tiles.json``, the manifest (what :func:`split` returns), with a ``split_id``;
 - ``tile-NNNNN.ply``, each tile (binary PLY, its border vertices first);
-- ``tile-NNNNN.simplified.ply`` and ``tile-NNNNN.done.json``, each simplified tile and
-  its status (what :func:`simplify` returns), written atomically, the status last.
+- ``tile-NNNNN.simplified.ply``, ``tile-NNNNN.quadrics`` and ``tile-NNNNN.done.json``,
+  each simplified tile, its vertices' quadrics and its status (what :func:`simplify`
+  returns), written atomically, the status last.
 
 A tile is **done** when its status names this split, this tile's file, the same options
-(a :func:`fingerprint`) and qem version, and a simplified file of the recorded size and
-CRC-32; anything else (a job killed before its status, a file cut short or changed,
+(a :func:`fingerprint`) and qem version, and a simplified file and quadrics of the
+recorded sizes and CRC-32s; anything else (a job killed before its status, a file cut short or changed,
 other options) is simplified again, to the same bytes. So a job is idempotent: run
 twice, retried by a scheduler, or run twice at once, it leaves the same files. Each tile
 job writes only its own tile's files, and removes only the leftovers of its own tile's
@@ -98,7 +99,7 @@ class Manifest(TypedDict):
     """``tiles.json``: what :func:`split` wrote."""
 
     qem_tiles: int
-    """The format version (1)."""
+    """The format version (2)."""
     split_id: str
     """A CRC-32 of the rest of the manifest: which split a status belongs to."""
     input: InputInfo
@@ -118,6 +119,8 @@ class TileStatus(TypedDict):
     output: str
     """The simplified tile's file name."""
     output_stamp: Stamp
+    quadrics_stamp: Stamp
+    """The size and CRC-32 of ``tile-NNNNN.quadrics``."""
     border_vertices: int
     triangles_in: int
     triangles_out: int
