@@ -16,7 +16,7 @@ use crate::manifest::{fingerprint, InputStamp, Manifest, Record};
 use crate::options::SimplifyFlags;
 use crate::progress::{bars_wanted, batch_bar, interrupted, CtrlCObserver};
 use crate::report::{write_json_atomically, BatchEntry, BatchJson, BatchSummary, SimplifyJson};
-use crate::simplify_cmd::simplify_file;
+use crate::simplify_cmd::{parse_size, simplify_file, MemoryBudget};
 use clap::{Args, ValueEnum};
 use qem_mesh::io::Format;
 use qem_mesh::simplify::SimplifyOptions;
@@ -89,6 +89,17 @@ pub struct BatchArgs {
     /// covers every input [default: off, every input runs].
     #[arg(long)]
     pub resume: bool,
+    /// Each file's run holds about this much memory at most, as with `qem simplify
+    /// --memory-budget` (a file whose in-core run would need more goes through tiles
+    /// in a temporary directory). Per file, so that the outputs do not depend on -j:
+    /// the whole batch holds up to -j times as much. A size in bytes, or with K, M, G
+    /// or T (powers of 1024), e.g. 500M, 4G [default: no budget].
+    #[arg(long, value_name = "SIZE", value_parser = parse_size)]
+    pub memory_budget: Option<u64>,
+    /// Where --memory-budget makes each file's temporary directory of tiles (removed
+    /// at the end of the file) [default: the output directory].
+    #[arg(long, value_name = "DIR", requires = "memory_budget")]
+    pub scratch: Option<PathBuf>,
     /// No progress bar and no summary line; failures are still printed [default: off].
     #[arg(short, long)]
     pub quiet: bool,
@@ -148,7 +159,17 @@ pub fn run(args: &BatchArgs) -> Result<(), Failure> {
 
     let options = args.flags.options()?;
     let format = args.format.map(Format::from);
-    let fingerprint = fingerprint(&options, &format);
+    let budget = args.memory_budget.map(|bytes| MemoryBudget {
+        bytes,
+        scratch: args.scratch.clone().unwrap_or_else(|| args.out_dir.clone()),
+    });
+    // A budget can change an output (a file that does not fit is tiled): a run with
+    // another budget is not the work done. Without one, the fingerprints of earlier
+    // runs stay valid.
+    let fingerprint = match &budget {
+        None => fingerprint(&options, &format),
+        Some(budget) => fingerprint(&(&options, budget.bytes), &format),
+    };
     let stale = remove_stale(&args.out_dir, &tasks);
     // No manifest when nothing can run (every input refused): the output directory is
     // then left as it was.
@@ -174,8 +195,14 @@ pub fn run(args: &BatchArgs) -> Result<(), Failure> {
         let mut done = Vec::new();
         while let Some(&i) = order.get(next.fetch_add(1, Ordering::Relaxed)) {
             let task = &tasks[i];
-            let (outcome, warning) =
-                run_recorded(task, &options, &fingerprint, args.resume, manifest.as_ref());
+            let (outcome, warning) = run_recorded(
+                task,
+                &options,
+                budget.as_ref(),
+                &fingerprint,
+                args.resume,
+                manifest.as_ref(),
+            );
             if let Some(warning) = warning {
                 let mut slot = manifest_warning.lock().unwrap_or_else(|p| p.into_inner());
                 slot.get_or_insert(warning);
@@ -397,6 +424,7 @@ fn remove_stale(out_dir: &Path, tasks: &[Task]) -> usize {
 fn run_recorded(
     task: &Task,
     options: &SimplifyOptions,
+    budget: Option<&MemoryBudget>,
     fingerprint: &str,
     resume: bool,
     manifest: Option<&Manifest>,
@@ -411,7 +439,7 @@ fn run_recorded(
             return (Outcome::Resumed(record.report.clone()), None);
         }
     }
-    let json = match run_task(task, options) {
+    let json = match run_task(task, options, budget) {
         Ok(json) => json,
         Err(e) => return (Outcome::Failed(e), None),
     };
@@ -425,8 +453,13 @@ fn run_recorded(
     (Outcome::Done(Box::new(json)), recorded.err())
 }
 
-/// Simplifies one input; the error is the one-line message.
-fn run_task(task: &Task, options: &SimplifyOptions) -> Result<SimplifyJson, String> {
+/// Simplifies one input (within `budget`, when given); the error is the one-line
+/// message.
+fn run_task(
+    task: &Task,
+    options: &SimplifyOptions,
+    budget: Option<&MemoryBudget>,
+) -> Result<SimplifyJson, String> {
     if let Some(refused) = &task.refused {
         return Err(refused.clone());
     }
@@ -445,7 +478,7 @@ fn run_task(task: &Task, options: &SimplifyOptions) -> Result<SimplifyJson, Stri
         (None, Err(e)) => return Err(format!("{}: {e}", task.input)),
         (None, Ok(_)) => return Err(format!("{}: no output name", task.input)),
     };
-    simplify_file(path, &output, options, &mut CtrlCObserver, true, None).map_err(|f| match f {
+    simplify_file(path, &output, options, &mut CtrlCObserver, true, budget).map_err(|f| match f {
         Failure::Failed(m) | Failure::Usage(m) => m,
         Failure::Interrupted => format!(
             "{}: interrupted (Ctrl-C); nothing was written for it",

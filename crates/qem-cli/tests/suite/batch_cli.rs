@@ -696,3 +696,77 @@ fn unwritable_output_directories_fail_with_one_line_each() {
     );
     assert_eq!(std::fs::read_dir(out.join("locked")).unwrap().count(), 0);
 }
+
+/// `--memory-budget` applies to each file as `qem simplify --memory-budget` does (the
+/// same bytes), tiles only the file that does not fit, leaves no tiles behind, and
+/// counts in `--resume`'s fingerprint.
+#[test]
+fn a_memory_budget_applies_to_each_file_as_in_qem_simplify() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    std::fs::create_dir_all(&input).unwrap();
+    // 80,000 triangles, which 8 MB over the fixed 32 MiB do not hold in core, and 288.
+    write_path(&input.join("big.ply"), &bumpy_grid(200, 1)).unwrap();
+    write_path(&input.join("small.ply"), &bumpy_grid(12, 2)).unwrap();
+    let budget = format!("{}", (32 << 20) + 8_000_000);
+    let out = dir.path().join("out");
+    let report = |n: u32| dir.path().join(format!("r{n}.json"));
+    let batch = |n: u32, extra: &[&str]| {
+        let r = report(n);
+        let mut args = vec![
+            "batch",
+            s(&input),
+            "--out-dir",
+            s(&out),
+            "--ratio",
+            "0.02",
+            "-j",
+            "2",
+            "--report",
+            s(&r),
+        ];
+        args.extend_from_slice(extra);
+        let o = qem(&args);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        json(&r)
+    };
+    let first = batch(1, &["--memory-budget", &budget]);
+    let entries = first["inputs"].as_array().unwrap();
+    let rounds = |name: &str| {
+        let entry = entries
+            .iter()
+            .find(|e| e["input"].as_str().unwrap().ends_with(name))
+            .unwrap();
+        entry["memory_budget"]["rounds"].as_array().unwrap().len()
+    };
+    assert_eq!((rounds("big.ply"), rounds("small.ply")), (1, 0), "{first}");
+    // No tiles left in the output directory (the default scratch).
+    assert_eq!(
+        files_under(&out),
+        vec![PathBuf::from("big.ply"), PathBuf::from("small.ply")]
+    );
+    for name in ["big.ply", "small.ply"] {
+        let alone = dir.path().join(format!("alone-{name}"));
+        let o = qem(&[
+            "simplify",
+            s(&input.join(name)),
+            "-o",
+            s(&alone),
+            "--ratio",
+            "0.02",
+            "--memory-budget",
+            &budget,
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(
+            std::fs::read(&alone).unwrap() == std::fs::read(out.join(name)).unwrap(),
+            "{name} differs from qem simplify's"
+        );
+    }
+    let same = batch(2, &["--memory-budget", &budget, "--resume"]);
+    assert_eq!(same["summary"]["resumed"], 2);
+    let other = batch(3, &["--memory-budget", "4G", "--resume"]);
+    assert_eq!(other["summary"]["resumed"], 0);
+    let none = batch(4, &["--resume"]);
+    assert_eq!(none["summary"]["resumed"], 0);
+}
