@@ -134,12 +134,18 @@ impl Frame {
         d2 * self.scale * self.scale
     }
 
-    /// A quadric of area-weighted planes in normalised coordinates, in world ones:
-    /// the same planes with world areas for weights and world squared distances for
-    /// errors, `Q_w(x) = s⁴ · Q(to_normalized(x))` for the scale `s`. This is how a
-    /// quadric leaves one run (one frame) for another ([`quadric_to_normalized`]
-    /// brings it into the other's frame): a vertex's quadric carried from a tile of a
-    /// mesh into the run that finishes the whole.
+    /// A quadric in normalised coordinates, in world units about `origin`: the same
+    /// planes, `Q_w(x) = s^k · Q(to_normalized(origin + x))` for the scale `s`, with
+    /// `k = 4` when the planes are weighted by areas (weights and squared distances
+    /// both scale by `s²`) and `k = 2` when their weights are numbers (`area_weighted`
+    /// false). This is how a quadric leaves one run (one frame) for another
+    /// ([`quadric_to_normalized`] brings it into the other's frame): a vertex's quadric
+    /// carried from a tile of a mesh into the run that finishes the whole.
+    ///
+    /// `origin` should lie near the mesh: a quadric's constant term is a sum of
+    /// squares of distances from its origin, and about a far origin (a scan in
+    /// georeferenced coordinates, 10^6 units from zero) what it measures near the mesh
+    /// is lost to rounding when it is moved back.
     ///
     /// [`quadric_to_normalized`]: Frame::quadric_to_normalized
     ///
@@ -147,40 +153,55 @@ impl Frame {
     /// use glam::DVec3;
     /// use qem_core::{Frame, Quadric};
     /// let f = Frame::from_bounds(DVec3::ZERO, DVec3::new(4.0, 2.0, 2.0));
-    /// // The plane z = 1 (world) is z = 0 normalised; unit weight there is weight 4
-    /// // (2² world area units) in the world.
+    /// // The plane z = 1 (world) is z = 0 normalised; unit area there is 4 world units
+    /// // of area (the scale is 2).
     /// let q = Quadric::from_plane(DVec3::Z, 0.0);
-    /// let world = f.quadric_to_world(&q);
-    /// assert_eq!(world.evaluate(DVec3::new(3.0, 0.5, 4.0)), 4.0 * 3.0 * 3.0);
-    /// assert_eq!(f.quadric_to_normalized(&world), q);
+    /// let origin = DVec3::new(2.0, 1.0, 1.0);
+    /// let world = f.quadric_to_world(&q, origin, true);
+    /// // 3 above the plane: squared distance 9, weight 4.
+    /// assert_eq!(world.evaluate(DVec3::new(1.0, -0.5, 3.0)), 4.0 * 9.0);
+    /// assert_eq!(f.quadric_to_normalized(&world, origin, true), q);
+    /// // A weight that is a number does not scale.
+    /// let unit = f.quadric_to_world(&q, origin, false);
+    /// assert_eq!(unit.evaluate(DVec3::new(1.0, -0.5, 3.0)), 9.0);
     /// ```
-    pub fn quadric_to_world(&self, q: &Quadric) -> Quadric {
-        rescaled(q, self.scale).translated(self.center)
+    pub fn quadric_to_world(&self, q: &Quadric, origin: DVec3, area_weighted: bool) -> Quadric {
+        rescaled(q, self.scale, area_weighted).translated(self.center - origin)
     }
 
-    /// A quadric in world coordinates (as [`quadric_to_world`] gives it) in this
-    /// frame's normalised ones: `Q(y) = Q_w(to_world(y)) / s⁴`.
+    /// A quadric in world units about `origin` (as [`quadric_to_world`] gives it) in
+    /// this frame's normalised coordinates: `Q(y) = Q_w(to_world(y) − origin) / s^k`.
     ///
     /// [`quadric_to_world`]: Frame::quadric_to_world
-    pub fn quadric_to_normalized(&self, q: &Quadric) -> Quadric {
-        rescaled(&q.translated(-self.center), 1.0 / self.scale)
+    pub fn quadric_to_normalized(
+        &self,
+        q: &Quadric,
+        origin: DVec3,
+        area_weighted: bool,
+    ) -> Quadric {
+        rescaled(
+            &q.translated(origin - self.center),
+            1.0 / self.scale,
+            area_weighted,
+        )
     }
 }
 
-/// `Q'(p) = k⁴ · Q(p / k)`: the same planes in coordinates `k` times larger, with
-/// weights (areas) `k²` times larger.
-fn rescaled(q: &Quadric, k: f64) -> Quadric {
-    let (k2, k3) = (k * k, k * k * k);
+/// `Q'(p) = k^n · Q(p / k)`, `n` 4 with `area_weighted` (else 2): the same planes in
+/// coordinates `k` times larger, their weights `k²` times larger when they are areas.
+fn rescaled(q: &Quadric, k: f64, area_weighted: bool) -> Quadric {
+    let weight = if area_weighted { k * k } else { 1.0 };
+    let (a, b, c) = (weight, weight * k, weight * k * k);
     Quadric {
-        xx: q.xx * k2,
-        xy: q.xy * k2,
-        xz: q.xz * k2,
-        yy: q.yy * k2,
-        yz: q.yz * k2,
-        zz: q.zz * k2,
-        x: q.x * k3,
-        y: q.y * k3,
-        z: q.z * k3,
-        c: q.c * k2 * k2,
+        xx: q.xx * a,
+        xy: q.xy * a,
+        xz: q.xz * a,
+        yy: q.yy * a,
+        yz: q.yz * a,
+        zz: q.zz * a,
+        x: q.x * b,
+        y: q.y * b,
+        z: q.z * b,
+        c: q.c * c,
     }
 }

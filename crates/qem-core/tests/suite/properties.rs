@@ -251,26 +251,41 @@ proptest! {
 }
 
 proptest! {
-    /// A triangle's area-weighted quadric built in a frame's normalised coordinates
-    /// and taken to the world is the one built from the world corners; and back.
+    /// A triangle's quadric (area-weighted, or of unit weight) built in a frame's
+    /// normalised coordinates and taken to the world about an origin near the mesh is
+    /// the one built there, to rounding of what it measures near the mesh; and back.
+    /// Far from zero too (a scan in georeferenced coordinates).
     #[test]
     fn a_quadric_taken_to_the_world_is_the_one_built_there(
         corners in proptest::array::uniform3(point()),
+        far in proptest::sample::select(vec![0.0, 1e3, 1e6, 5e6]),
         lo in point(),
         extent in (0.01..100.0f64, 0.01..100.0f64, 0.01..100.0f64),
         p in point(),
     ) {
+        let lo = lo + DVec3::new(far, -far, 0.5 * far);
         let hi = lo + DVec3::new(extent.0, extent.1, extent.2);
         let frame = Frame::from_bounds(lo, hi);
         let world = corners.map(|c| lo + c.abs() * 0.25 * (hi - lo));
+        let origin = world[0];
         let [a, b, c] = world.map(|w| frame.to_normalized(w));
-        let built_in_world = Quadric::from_triangle(world[0], world[1], world[2]);
-        let carried = frame.quadric_to_world(&Quadric::from_triangle(a, b, c));
-        let x = frame.to_world(p);
-        let scale = built_in_world.magnitude() * (1.0 + x.length_squared());
-        prop_assert!((carried.evaluate(x) - built_in_world.evaluate(x)).abs() <= 1e-9 * scale);
-        let back = frame.quadric_to_normalized(&carried);
-        let n_scale = back.magnitude() * (1.0 + p.length_squared());
-        prop_assert!((back.evaluate(p) - Quadric::from_triangle(a, b, c).evaluate(p)).abs() <= 1e-9 * n_scale);
+        let [wa, wb, wc] = world.map(|w| w - origin);
+        for area_weighted in [true, false] {
+            let (normalized, built_in_world) = if area_weighted {
+                (Quadric::from_triangle(a, b, c), Quadric::from_triangle(wa, wb, wc))
+            } else {
+                (
+                    Quadric::from_triangle_unweighted(a, b, c),
+                    Quadric::from_triangle_unweighted(wa, wb, wc),
+                )
+            };
+            let carried = frame.quadric_to_world(&normalized, origin, area_weighted);
+            let x = frame.to_world(p) - origin;
+            let scale = built_in_world.magnitude() * (1.0 + x.length_squared());
+            prop_assert!((carried.evaluate(x) - built_in_world.evaluate(x)).abs() <= 1e-9 * scale);
+            let back = frame.quadric_to_normalized(&carried, origin, area_weighted);
+            let n_scale = normalized.magnitude() * (1.0 + p.length_squared());
+            prop_assert!((back.evaluate(p) - normalized.evaluate(p)).abs() <= 1e-9 * n_scale);
+        }
     }
 }

@@ -9,17 +9,25 @@
 //! 0.34% (BENCHMARKS.md, "Under a memory budget").
 
 use crate::clean::Cleaned;
-use qem_core::Quadric;
+use qem_core::{DVec3, Quadric};
 
-/// Each vertex's quadric in world units ([`qem_core::Frame::quadric_to_world`]), so
-/// that runs in different frames add up to what one run would have summed;
-/// [`NOT_CARRIED`] for a vertex whose quadric the run sums from its faces as usual.
-///
-/// Not `Option<Quadric>`: the run puts the carried quadrics in its vertex order in
-/// place and makes them its own quadric array, so they are held once (80 bytes a
-/// vertex at the setup's peak, where a separate array was measured at 70 MB more on
-/// the 10M-triangle budget run).
-pub(crate) type CarriedQuadrics = Vec<Quadric>;
+/// Vertex quadrics in world units about `origin` ([`qem_core::Frame::quadric_to_world`]),
+/// so that runs in different frames add up to what one run would have summed.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct CarriedQuadrics {
+    /// The point the quadrics are about, in world units: near the mesh, so that they
+    /// keep their precision whatever its coordinates (the tiles of a split use the
+    /// centre of their centroids' box, [`crate::tiles::jobs::Manifest::quadric_origin`]).
+    pub origin: DVec3,
+    /// One per vertex; [`NOT_CARRIED`] for a vertex whose quadric the run sums from
+    /// its faces as usual.
+    ///
+    /// Quadrics rather than `Option`s: the run puts them in its vertex order in place
+    /// and makes them its own quadric array, so the engine never holds them twice (a
+    /// separate array was measured at 70 MB more at the setup's peak on the 10M
+    /// budget run).
+    pub quadrics: Vec<Quadric>,
+}
 
 /// The entry of a vertex with no carried quadric: NaN entries, which no quadric of
 /// finite planes has.
@@ -43,15 +51,30 @@ pub(crate) fn is_carried(q: &Quadric) -> bool {
 }
 
 /// `seed` (one per input vertex) by the cleaned mesh's vertex: the quadrics of input
-/// vertices welded into one are summed; [`NOT_CARRIED`] where no input vertex has one.
+/// vertices welded into one are summed; a cleaned vertex is [`NOT_CARRIED`] when any of
+/// its input vertices is not (its faces' planes would be lost in the carried ones'
+/// quadric: the run sums its quadric from its faces instead). When the cleaning
+/// merged and dropped nothing, the seed is returned as it is, not copied.
 pub(super) fn by_cleaned_vertex(seed: CarriedQuadrics, cleaned: &Cleaned) -> CarriedQuadrics {
-    let mut summed: CarriedQuadrics = vec![NOT_CARRIED; cleaned.mesh.vertex_count()];
-    for (&to, q) in cleaned.vertex_map.iter().zip(seed) {
-        if let Some(sum) = summed.get_mut(to as usize).filter(|_| is_carried(&q)) {
-            *sum = if is_carried(sum) { *sum + q } else { q };
+    let map = &cleaned.vertex_map;
+    let n = cleaned.mesh.vertex_count();
+    if map.len() == n && map.iter().enumerate().all(|(i, &to)| to as usize == i) {
+        return seed;
+    }
+    let mut summed = vec![Quadric::ZERO; n];
+    for (&to, q) in map.iter().zip(seed.quadrics) {
+        if let Some(sum) = summed.get_mut(to as usize) {
+            *sum = if is_carried(&q) {
+                *sum + q
+            } else {
+                NOT_CARRIED
+            };
         }
     }
-    summed
+    CarriedQuadrics {
+        origin: seed.origin,
+        quadrics: summed,
+    }
 }
 
 /// Reorders `values` in place so that place `v` holds what place `from[v]` held, when
@@ -95,23 +118,21 @@ pub(super) fn gather_in_place<T: Copy>(values: &mut [T], from: &[u32]) -> bool {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{simplify_carrying, NoObserver, QuadricMode, SimplifyOptions, Target};
+    use super::super::{
+        simplify_carrying, NoObserver, QuadricMode, SimplifyOptions, Target, Weighting,
+    };
     use super::*;
     use crate::IndexedMesh;
-    use qem_core::DVec3;
 
-    /// An open, bumpy 12 x 9 grid (216 triangles), far from the origin and not unit
-    /// sized, so that frames matter.
-    fn bumpy_grid() -> IndexedMesh {
-        let (nx, ny) = (12u32, 9u32);
+    /// An open, bumpy `nx` x `ny` grid of squares 2 units wide from `corner`, so that
+    /// frames matter.
+    fn bumpy_grid(nx: u32, ny: u32, corner: DVec3) -> IndexedMesh {
         let positions = (0..=ny)
             .flat_map(|y| (0..=nx).map(move |x| (f64::from(x), f64::from(y))))
             .map(|(x, y)| {
-                [
-                    300.0 + 2.0 * x,
-                    -40.0 + 2.0 * y,
-                    7.0 + 0.4 * (x * 0.9).sin() * (y * 0.7).cos(),
-                ]
+                let p =
+                    corner + DVec3::new(2.0 * x, 2.0 * y, 0.4 * (x * 0.9).sin() * (y * 0.7).cos());
+                p.to_array()
             })
             .collect();
         let triangles = (0..ny)
@@ -121,12 +142,15 @@ mod tests {
         IndexedMesh::new(positions, triangles)
     }
 
-    /// `a` and `b` agree at a few points, to rounding of their size.
+    const CORNER: DVec3 = DVec3::new(300.0, -40.0, 7.0);
+
+    /// `a` and `b` (about the same origin, at the grid's corner) agree at a few points
+    /// of the grid, to rounding of what they measure there.
     fn same_quadric(a: &Quadric, b: &Quadric) -> bool {
         let points = [
-            DVec3::new(300.0, -40.0, 7.0),
-            DVec3::new(310.0, -30.0, 8.0),
-            DVec3::new(325.0, -22.0, 6.0),
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(10.0, 10.0, 1.0),
+            DVec3::new(25.0, 18.0, -1.0),
         ];
         points.iter().all(|&p| {
             let scale = (a.magnitude() + b.magnitude()) * (1.0 + p.length_squared());
@@ -134,64 +158,19 @@ mod tests {
         })
     }
 
-    /// A run that contracts nothing hands back, for each vertex, the quadric it was
-    /// seeded with (through both frames and the engine's vertex order), with no
-    /// border plane added on top; an unseeded vertex gets the quadric the run sums.
-    #[test]
-    fn a_run_hands_back_the_quadrics_it_was_seeded_with() {
-        let mesh = bumpy_grid();
-        let n = mesh.triangle_count();
-        let options = SimplifyOptions::DEFAULT.with_target(Target::Triangles(n));
-        let (_, summed) =
-            simplify_carrying(mesh.clone(), &options, None, &mut NoObserver).expect("run");
-        let mut seed: CarriedQuadrics = (mesh.positions.iter().enumerate())
-            .map(|(i, p)| Quadric::from_point(DVec3::from_array(*p), 1.0 + i as f64))
-            .collect();
-        seed[5] = NOT_CARRIED;
-        let (out, back) =
-            simplify_carrying(mesh.clone(), &options, Some(seed.clone()), &mut NoObserver)
-                .expect("run");
-        assert_eq!(out.mesh.positions, mesh.positions, "nothing contracted");
-        assert_eq!(back.len(), seed.len());
-        for (v, (back, seed)) in back.iter().zip(&seed).enumerate() {
-            let expected = if v == 5 { &summed[5] } else { seed };
-            assert!(same_quadric(back, expected), "vertex {v}");
-        }
-    }
-
-    /// Summed quadrics only add up: what a run hands back sums to what it started
-    /// from, and a run seeded with it hands back the same sum again.
-    #[test]
-    fn quadrics_carried_through_two_runs_add_up_to_the_input_planes() {
-        let mesh = bumpy_grid();
-        let n = mesh.triangle_count();
-        let sum = SimplifyOptions::DEFAULT.with_quadrics(QuadricMode::Sum);
-        let total = |qs: &[Quadric]| qs.iter().copied().sum::<Quadric>();
-        let (_, start) = simplify_carrying(
-            mesh.clone(),
-            &sum.clone().with_target(Target::Triangles(n)),
-            None,
-            &mut NoObserver,
-        )
-        .expect("run");
-        let (half, first) = simplify_carrying(
-            mesh,
-            &sum.clone().with_target(Target::Triangles(n / 2)),
-            None,
-            &mut NoObserver,
-        )
-        .expect("run");
-        assert!(half.mesh.triangle_count() <= n / 2);
-        assert!(same_quadric(&total(&first), &total(&start)));
-        let (quarter, second) = simplify_carrying(
-            half.mesh,
-            &sum.with_target(Target::Triangles(n / 4)),
-            Some(first.clone()),
-            &mut NoObserver,
-        )
-        .expect("run");
-        assert!(quarter.mesh.triangle_count() <= n / 4);
-        assert!(same_quadric(&total(&second), &total(&first)));
+    /// Runs `mesh` to `target` triangles, seeded with `seed`, handing back about the
+    /// grid's corner.
+    fn run(
+        mesh: &IndexedMesh,
+        options: &SimplifyOptions,
+        target: usize,
+        seed: Option<CarriedQuadrics>,
+        corner: DVec3,
+    ) -> (IndexedMesh, CarriedQuadrics) {
+        let options = options.clone().with_target(Target::Triangles(target));
+        let (out, back) = simplify_carrying(mesh.clone(), &options, seed, corner, &mut NoObserver)
+            .expect("simplifies");
+        (out.mesh, back)
     }
 
     #[test]
@@ -207,6 +186,90 @@ mod tests {
             let mut three = vec![1, 2, 3];
             assert!(!gather_in_place(&mut three, bad));
             assert_eq!(three, vec![1, 2, 3]);
+        }
+    }
+
+    /// A run that contracts nothing hands back, for each vertex, the quadric it was
+    /// seeded with (through both frames and the engine's vertex order), with no
+    /// border plane added on top; an unseeded vertex gets the quadric the run sums
+    /// (with area weights: a mixed weighting's offset is the mean area of the faces
+    /// summed, here those around vertex 5 only).
+    #[test]
+    fn a_run_hands_back_the_quadrics_it_was_seeded_with() {
+        let mesh = bumpy_grid(12, 9, CORNER);
+        let n = mesh.triangle_count();
+        let options = SimplifyOptions::DEFAULT.with_weighting(Weighting::Area);
+        let (_, summed) = run(&mesh, &options, n, None, CORNER);
+        let mut seed = CarriedQuadrics {
+            origin: CORNER,
+            quadrics: (mesh.positions.iter().enumerate())
+                .map(|(i, p)| Quadric::from_point(DVec3::from_array(*p) - CORNER, 1.0 + i as f64))
+                .collect(),
+        };
+        seed.quadrics[5] = NOT_CARRIED;
+        let (out, back) = run(&mesh, &options, n, Some(seed.clone()), CORNER);
+        assert_eq!(out.positions, mesh.positions, "nothing contracted");
+        assert_eq!(back.quadrics.len(), seed.quadrics.len());
+        for (v, (back, seed)) in back.quadrics.iter().zip(&seed.quadrics).enumerate() {
+            let expected = if v == 5 { &summed.quadrics[5] } else { seed };
+            assert!(same_quadric(back, expected), "vertex {v}");
+        }
+    }
+
+    /// Summed quadrics only add up: what a run hands back sums to what it started
+    /// from, and a run seeded with it hands back the same sum again.
+    #[test]
+    fn quadrics_carried_through_two_runs_add_up_to_the_input_planes() {
+        let mesh = bumpy_grid(12, 9, CORNER);
+        let n = mesh.triangle_count();
+        let sum = SimplifyOptions::DEFAULT.with_quadrics(QuadricMode::Sum);
+        let total = |c: &CarriedQuadrics| c.quadrics.iter().copied().sum::<Quadric>();
+        let (_, start) = run(&mesh, &sum, n, None, CORNER);
+        let (half, first) = run(&mesh, &sum, n / 2, None, CORNER);
+        assert!(half.triangle_count() <= n / 2);
+        assert!(same_quadric(&total(&first), &total(&start)));
+        let (quarter, second) = run(&half, &sum, n / 4, Some(first.clone()), CORNER);
+        assert!(quarter.triangle_count() <= n / 4);
+        assert!(same_quadric(&total(&second), &total(&first)));
+    }
+
+    /// Far from zero (a scan in georeferenced coordinates), a run seeded with the
+    /// quadrics it would sum itself makes the same contractions as without the seed:
+    /// the quadrics about an origin near the mesh keep their precision.
+    #[test]
+    fn far_from_zero_a_run_seeded_with_its_own_quadrics_is_the_same_run() {
+        let corner = DVec3::new(3.0e6, -5.0e6, 1.0e5);
+        let mesh = bumpy_grid(12, 9, corner);
+        let n = mesh.triangle_count();
+        let sum = SimplifyOptions::DEFAULT.with_quadrics(QuadricMode::Sum);
+        let (_, own) = run(&mesh, &sum, n, None, corner);
+        let (plain, _) = run(&mesh, &sum, n / 3, None, corner);
+        let (seeded, _) = run(&mesh, &sum, n / 3, Some(own), corner);
+        assert_eq!(seeded.triangles, plain.triangles);
+        for (a, b) in seeded.positions.iter().zip(&plain.positions) {
+            let d = DVec3::from_array(*a).distance(DVec3::from_array(*b));
+            assert!(d <= 1e-6, "{a:?} against {b:?}");
+        }
+    }
+
+    /// A vertex inside a part of a mesh gets the quadric it has in the whole mesh,
+    /// though the part's run has another frame: with area weights (which scale with
+    /// the frame) and with unit weights (which do not).
+    #[test]
+    fn an_inner_vertex_of_a_part_carries_its_quadric_in_the_whole() {
+        let whole = bumpy_grid(24, 18, CORNER);
+        let part = bumpy_grid(12, 9, CORNER);
+        // Vertex (6, 4): inside both, away from every border.
+        let (in_whole, in_part) = (4 * 25 + 6, 4 * 13 + 6);
+        assert_eq!(whole.positions[in_whole], part.positions[in_part]);
+        for weighting in [Weighting::Area, Weighting::Unweighted] {
+            let options = SimplifyOptions::DEFAULT.with_weighting(weighting);
+            let (_, w) = run(&whole, &options, whole.triangle_count(), None, CORNER);
+            let (_, p) = run(&part, &options, part.triangle_count(), None, CORNER);
+            assert!(
+                same_quadric(&w.quadrics[in_whole], &p.quadrics[in_part]),
+                "{weighting:?}"
+            );
         }
     }
 }

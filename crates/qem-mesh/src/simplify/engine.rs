@@ -28,7 +28,7 @@ use super::nth_key::nth_key;
 use super::observer::{Contraction, Observer, Progress};
 use super::options::QuadricMode;
 use super::options::VirtualPairs;
-use super::options::{BoundaryMode, SimplifyOptions, SEAM_PLANE_WEIGHT};
+use super::options::{BoundaryMode, SimplifyOptions, Weighting, SEAM_PLANE_WEIGHT};
 use super::orientation::{InputSurface, Quick};
 use super::pair_set::PairSet;
 use super::pass_blocks::{
@@ -340,7 +340,7 @@ impl Engine {
         };
         engine.set_block_vertices(BLOCK_VERTICES);
         if let Some(seed) = seed {
-            engine.take_seed(seed);
+            engine.take_seed(seed, options.weighting);
         }
         // The incident lists first: the quadrics are summed along them.
         engine.list_incident_triangles();
@@ -484,19 +484,29 @@ impl Engine {
     fn sum_face_planes(&mut self, options: &SimplifyOptions) -> Option<f64> {
         // The areas on both cores, summed on one in the order of `live`: the bits of
         // that order, whatever the thread count.
+        // In a seeded run, over the triangles with a corner the seed does not carry
+        // only: the rest were simplified by an earlier run, their areas far above the
+        // input's, while these are input faces still (the tiles' border strips,
+        // `crate::tiles::budget`), and the planes summed here are theirs.
+        let summed_here = |t: u32| {
+            let corners = self.triangles[t as usize];
+            self.seeded.is_empty() || corners.iter().any(|&c| !self.seeded[c as usize])
+        };
         let areas: Vec<f64> = self
             .live
             .par_iter()
+            .filter(|&&t| summed_here(t))
             .map(|&t| {
                 let [a, b, c] = self.corners(self.triangles[t as usize]);
                 unit_normal_and_area(a, b, c).map_or(0.0, |(_, area)| area)
             })
             .collect();
+        let count = areas.len();
         let areas: f64 = areas.iter().sum();
-        let mean_area = if self.live.is_empty() {
+        let mean_area = if count == 0 {
             0.0
         } else {
-            areas / self.live.len() as f64
+            areas / count as f64
         };
         let area_offset = options.weighting.area_offset(mean_area);
         // Each vertex's quadric, summed over its live triangles in the order of
@@ -1064,8 +1074,12 @@ impl Engine {
     /// vertices it does not carry, and no border or seam plane is added to those it
     /// does (their quadrics hold them already). A seed of another length than the
     /// vertices is not taken (a caller's bug: the run then sums every quadric).
-    fn take_seed(&mut self, mut seed: CarriedQuadrics) {
+    fn take_seed(&mut self, seed: CarriedQuadrics, weighting: Weighting) {
         debug_assert!(self.exact.is_none(), "a seeded run sums its quadrics");
+        let CarriedQuadrics {
+            origin,
+            quadrics: mut seed,
+        } = seed;
         if !gather_in_place(&mut seed, &self.vertex_from) {
             debug_assert!(
                 false,
@@ -1075,17 +1089,18 @@ impl Engine {
             );
             return;
         }
-        let frame = self.frame;
+        let (frame, area_weighted) = (self.frame, weighting.area_weighted());
         seed.par_iter_mut()
             .filter(|q| is_carried(q))
-            .for_each(|q| *q = frame.quadric_to_normalized(q));
+            .for_each(|q| *q = frame.quadric_to_normalized(q, origin, area_weighted));
         self.seeded = seed.iter().map(is_carried).collect();
         self.quadric = seed;
     }
 
     /// The quadrics of [`to_mesh`](Self::to_mesh)'s vertices, in its order, in world
-    /// units.
-    pub fn output_quadrics(&self) -> Vec<Quadric> {
+    /// units about `origin`, their planes weighted by `weighting` (the run's).
+    pub fn output_quadrics(&self, origin: DVec3, weighting: Weighting) -> Vec<Quadric> {
+        let area_weighted = weighting.area_weighted();
         let mut used = vec![false; self.world.len()];
         for &t in &self.live {
             for c in self.triangles[t as usize] {
@@ -1099,7 +1114,10 @@ impl Engine {
             .collect();
         by_origin.sort_unstable();
         (by_origin.iter())
-            .map(|&(_, v)| self.frame.quadric_to_world(&self.quadric[v as usize]))
+            .map(|&(_, v)| {
+                let q = &self.quadric[v as usize];
+                self.frame.quadric_to_world(q, origin, area_weighted)
+            })
             .collect()
     }
 

@@ -163,20 +163,20 @@ pub fn simplify_owned(
 struct Carry {
     /// One per input vertex, replacing what the run would sum for it.
     seed: Option<CarriedQuadrics>,
-    /// Whether the run hands its output vertices' quadrics back.
-    hand_back: bool,
+    /// The origin the run hands its output vertices' quadrics back about, if it does.
+    hand_back: Option<DVec3>,
 }
 
 impl Carry {
     const NONE: Carry = Carry {
         seed: None,
-        hand_back: false,
+        hand_back: None,
     };
 }
 
 /// [`simplify_owned`] carrying vertex quadrics: `seed` (one per input vertex) replaces
 /// the quadrics the run would sum from the faces, and the result comes with each output
-/// vertex's quadric, in world units. With a seed the quadrics are summed
+/// vertex's quadric, in world units about `origin` (a point near the mesh). With a seed the quadrics are summed
 /// ([`QuadricMode::Sum`]): the planes behind a carried quadric are not known, so the
 /// planes a pair shares cannot be taken out of its merged quadric. Not with
 /// [`Method::Clustering`], which has no vertex quadrics to hand back (the tiles and the
@@ -185,8 +185,9 @@ pub(crate) fn simplify_carrying(
     mesh: IndexedMesh,
     options: &SimplifyOptions,
     seed: Option<CarriedQuadrics>,
+    origin: DVec3,
     observer: &mut dyn Observer,
-) -> Result<(Simplified, Vec<Quadric>), SimplifyError> {
+) -> Result<(Simplified, CarriedQuadrics), SimplifyError> {
     debug_assert_ne!(options.method, Method::Clustering);
     let triangles_in = mesh.triangle_count();
     let options = match seed {
@@ -195,7 +196,7 @@ pub(crate) fn simplify_carrying(
     };
     let carry = Carry {
         seed,
-        hand_back: true,
+        hand_back: Some(origin),
     };
     let (mut levels, mut quadrics) = levels_of(
         Cow::Owned(mesh),
@@ -274,7 +275,7 @@ fn levels_of(
     levels: &[Target],
     observer: &mut dyn Observer,
     carry: Carry,
-) -> Result<(Vec<Simplified>, Vec<Vec<Quadric>>), SimplifyError> {
+) -> Result<(Vec<Simplified>, Vec<CarriedQuadrics>), SimplifyError> {
     if options.method == Method::Clustering {
         return Ok((cluster_levels(&mesh, options, levels)?, Vec::new()));
     }
@@ -349,7 +350,8 @@ fn levels_of(
         let clock = Instant::now();
         observer.phase(Phase::Compacting);
         let mut raw = engine.to_mesh();
-        let raw_quadrics = carry.hand_back.then(|| engine.output_quadrics());
+        let raw_quadrics = (carry.hand_back)
+            .map(|origin| (origin, engine.output_quadrics(origin, options.weighting)));
         // Zero area is judged in the loop's frame, not in the output's own (see
         // `checks::is_zero_area`): the loop refused every contraction that would make a
         // face zero-area, so this drops only faces that came in so (cleaning passes off).
@@ -404,14 +406,17 @@ fn levels_of(
             faces_flipped: engine.flipped_faces(),
             timings,
         };
-        if let Some(raw_quadrics) = raw_quadrics {
+        if let Some((origin, raw_quadrics)) = raw_quadrics {
             let mut out_quadrics = vec![Quadric::ZERO; out.vertex_count()];
             for (&to, q) in final_clean.vertex_map.iter().zip(raw_quadrics) {
                 if to != Cleaned::REMOVED {
                     out_quadrics[to as usize] += q;
                 }
             }
-            quadrics.push(out_quadrics);
+            quadrics.push(CarriedQuadrics {
+                origin,
+                quadrics: out_quadrics,
+            });
         }
         results.push(Simplified { mesh: out, report });
     }

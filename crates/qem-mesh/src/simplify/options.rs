@@ -106,6 +106,12 @@ pub enum Weighting {
 }
 
 impl Weighting {
+    /// Whether the planes' weights are areas (then they scale with a frame's scale
+    /// squared, [`qem_core::Frame::quadric_to_world`]) rather than numbers.
+    pub(crate) fn area_weighted(self) -> bool {
+        self.area_offset(1.0).is_some()
+    }
+
     /// The constant added to every face's area, `s · Ā` (0 for [`Area`](Self::Area)),
     /// or `None` for unit weights ([`Unweighted`](Self::Unweighted), or an infinite
     /// `s`). `mean_area` is `Ā`.

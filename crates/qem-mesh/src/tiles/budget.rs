@@ -18,20 +18,23 @@
 //!   rest. (A later round cuts the merged mesh anew, so its tiles' borders fall
 //!   elsewhere.)
 //! - The in-core finish starts from the vertex quadrics the tiles ended with (their
-//!   [`quadrics_file`](super::jobs::quadrics_file)s), not from quadrics summed anew
-//!   from the merged mesh's faces: each vertex still stands for the part of the input
-//!   surface it replaced. Only the tiles' border vertices, whose quadrics in the
-//!   tiles hold the planes of the cut, have theirs summed from the faces around them
-//!   (input faces still: their neighbours were locked too). The finish sums its
+//!   [`quadrics_file`](super::jobs::quadrics_file)s, in world units about a point
+//!   near the mesh so that they keep their precision far from zero), not from
+//!   quadrics summed anew from the merged mesh's faces: each vertex still stands for
+//!   the part of the input surface it replaced. Only the tiles' border vertices,
+//!   whose quadrics in the tiles hold the planes of the cut, have theirs summed from
+//!   the faces around them (input faces still: their neighbours were locked too, so
+//!   a mixed weighting's mean area is taken over those faces). The finish sums its
 //!   quadrics (`QuadricMode::Sum`): which planes two carried quadrics share is not
 //!   carried.
 //!
 //!   Measured on the 10M-triangle cube-sphere at ratio 0.01 (BENCHMARKS.md, "Under a
 //!   memory budget"): quadrics summed anew gave a Hausdorff distance 31% above the
 //!   in-core run's, carried ones 7% above it, the mean error within 2% either way. On
-//!   the dragon the summed quadrics cost the mean error 6 to 7% (as `--quadrics sum`
-//!   does in core). A second round cuts the merged mesh without its quadrics (the
-//!   split writes meshes only), so its tiles sum theirs from the merged mesh's faces.
+//!   the dragon the summed quadrics cost the mean error 5.5 to 7.6% (as `--quadrics
+//!   sum` does in core). A second round cuts the merged mesh without its quadrics
+//!   (the split writes meshes only), so its tiles sum theirs from the merged mesh's
+//!   faces.
 //!
 //! Why not tile straight to the target: locked strips take a share of each tile's
 //! budget that grows as the ratio falls, and tiles simplified far below it fold. On
@@ -274,6 +277,9 @@ pub fn simplify_within(
                 });
             }
             let dir = work.path().join(format!("round-{}", rounds.len() + 1));
+            // The split cuts meshes only: an earlier round's quadrics are not needed
+            // again, and not held through this round.
+            drop(carried.take());
             let (round, merged, quadrics) = tile_round(
                 SplitInput {
                     name: std::mem::take(&mut name),
@@ -304,7 +310,10 @@ pub fn simplify_within(
     }
     let finish = options.clone().with_target(finish_target);
     let result = match carried {
-        Some(carried) => simplify_carrying(mesh, &finish, Some(carried), observer)?.0,
+        Some(carried) => {
+            let origin = carried.origin;
+            simplify_carrying(mesh, &finish, Some(carried), origin, observer)?.0
+        }
         None => simplify_owned(mesh, &finish, observer)?,
     };
     Ok(BudgetRun {

@@ -93,7 +93,7 @@ use crate::simplify::{
     StopReason, Target,
 };
 use crate::{IndexedMesh, InputError};
-use qem_core::Quadric;
+use qem_core::{DVec3, Quadric};
 use serde::{Deserialize, Serialize};
 use std::io::{ErrorKind, Write};
 use std::ops::Range;
@@ -128,11 +128,12 @@ pub fn simplified_file(k: usize) -> String {
 }
 
 /// The name of tile `k`'s quadrics: `tile-NNNNN.quadrics`. Each vertex's quadric of
-/// the simplified tile, in world units ([`qem_core::Frame::quadric_to_world`]): what
-/// its vertex stands for of the tile's input surface. The file is
-/// [`QUADRICS_MAGIC`], the vertex count (a little-endian `u64`), then the ten entries
-/// of each quadric ([`Quadric::entries`], little-endian `f64`s), in the simplified
-/// file's vertex order.
+/// the simplified tile, in world units about the split's
+/// [`Manifest::quadric_origin`] ([`qem_core::Frame::quadric_to_world`]): what its
+/// vertex stands for of the tile's input surface. The file is [`QUADRICS_MAGIC`], the
+/// vertex count (a little-endian `u64`), the origin (three little-endian `f64`s), then
+/// the ten entries of each quadric ([`Quadric::entries`], little-endian `f64`s), in
+/// the simplified file's vertex order.
 pub fn quadrics_file(k: usize) -> String {
     format!("tile-{k:05}.quadrics")
 }
@@ -140,11 +141,14 @@ pub fn quadrics_file(k: usize) -> String {
 /// The first bytes of a [`quadrics_file`].
 pub const QUADRICS_MAGIC: &[u8; 16] = b"qem quadrics v1\n";
 
-/// The bytes of a [`quadrics_file`] holding `quadrics`.
-fn quadrics_bytes(quadrics: &[Quadric]) -> Vec<u8> {
-    let mut bytes = Vec::with_capacity(24 + 80 * quadrics.len());
+/// The bytes of a [`quadrics_file`] holding `quadrics` about `origin`.
+fn quadrics_bytes(quadrics: &[Quadric], origin: DVec3) -> Vec<u8> {
+    let mut bytes = Vec::with_capacity(QUADRICS_HEADER + 80 * quadrics.len());
     bytes.extend_from_slice(QUADRICS_MAGIC);
     bytes.extend_from_slice(&(quadrics.len() as u64).to_le_bytes());
+    for e in origin.to_array() {
+        bytes.extend_from_slice(&e.to_le_bytes());
+    }
     for q in quadrics {
         for e in q.entries() {
             bytes.extend_from_slice(&e.to_le_bytes());
@@ -153,12 +157,22 @@ fn quadrics_bytes(quadrics: &[Quadric]) -> Vec<u8> {
     bytes
 }
 
+/// The bytes of a [`quadrics_file`] before its quadrics.
+const QUADRICS_HEADER: usize = 16 + 8 + 24;
+
 /// The quadrics of a [`quadrics_file`]'s `bytes`, when they hold `vertices` of them
-/// (else `None`).
-fn quadrics_of(bytes: &[u8], vertices: usize) -> Option<Vec<Quadric>> {
+/// about `origin` (else `None`).
+fn quadrics_of(bytes: &[u8], vertices: usize, origin: DVec3) -> Option<Vec<Quadric>> {
     let rest = bytes.strip_prefix(QUADRICS_MAGIC)?;
-    let (count, entries) = rest.split_first_chunk::<8>()?;
-    if u64::from_le_bytes(*count) != vertices as u64 || entries.len() != 80 * vertices {
+    let (count, rest) = rest.split_first_chunk::<8>()?;
+    let (written_origin, entries) = rest.split_first_chunk::<24>()?;
+    let origin_bytes: Vec<u8> = (origin.to_array().iter())
+        .flat_map(|e| e.to_le_bytes())
+        .collect();
+    if u64::from_le_bytes(*count) != vertices as u64
+        || written_origin[..] != origin_bytes[..]
+        || entries.len() != 80 * vertices
+    {
         return None;
     }
     let quadrics = entries.chunks_exact(80).map(|quadric| {
@@ -223,6 +237,32 @@ pub struct Manifest {
     pub partition: PartitionJson,
     /// One entry per tile, tile `k` at index `k`.
     pub tiles: Vec<TileEntry>,
+}
+
+impl Manifest {
+    /// The point the tiles' quadrics are about ([`quadrics_file`]): the centre of the
+    /// box of every tile's centroids. Near the mesh, so that the quadrics keep their
+    /// precision whatever its coordinates; from the manifest, so that every tile job
+    /// and the merge find the same one.
+    pub fn quadric_origin(&self) -> DVec3 {
+        let mut tiles = self.tiles.iter();
+        let Some(first) = tiles.next() else {
+            return DVec3::ZERO;
+        };
+        let (lo, hi) = tiles.fold(
+            (
+                DVec3::from_array(first.centroid_min),
+                DVec3::from_array(first.centroid_max),
+            ),
+            |(lo, hi), t| {
+                (
+                    lo.min(DVec3::from_array(t.centroid_min)),
+                    hi.max(DVec3::from_array(t.centroid_max)),
+                )
+            },
+        );
+        lo * 0.5 + hi * 0.5
+    }
 }
 
 /// The input of a split, as its manifest describes it.
@@ -1129,7 +1169,8 @@ impl PendingTile<'_> {
             .options
             .clone()
             .with_locked_vertices(self.locked);
-        let simplified = simplify_carrying(self.tile.mesh, &options, None, observer);
+        let origin = self.dir.manifest.quadric_origin();
+        let simplified = simplify_carrying(self.tile.mesh, &options, None, origin, observer);
         let (result, quadrics) = simplified.map_err(|e| match e {
             SimplifyError::Cancelled { .. } => TilesError::Cancelled,
             e => TilesError::file(dir.join(tile_file(k)), Problem::Simplify(e)),
@@ -1139,14 +1180,14 @@ impl PendingTile<'_> {
         }
         let stop_reason = result.report.stop_reason.as_str().to_string();
         let (tile, new_number) = Tile::border_first_numbered(&border_positions, result.mesh);
-        let mut numbered = vec![Quadric::ZERO; quadrics.len()];
-        for (q, &new) in quadrics.into_iter().zip(&new_number) {
+        let mut numbered = vec![Quadric::ZERO; quadrics.quadrics.len()];
+        for (q, &new) in quadrics.quadrics.into_iter().zip(&new_number) {
             numbered[new as usize] = q;
         }
         let out_path = dir.join(simplified_file(k));
         let out = ply_bytes(&tile.mesh, &out_path)?;
         write_bytes(&out_path, &out)?;
-        let quadrics = quadrics_bytes(&numbered);
+        let quadrics = quadrics_bytes(&numbered, origin);
         write_bytes(&dir.join(quadrics_file(k)), &quadrics)?;
         let status = TileStatus {
             qem_tiles_status: VERSION,
@@ -1170,10 +1211,12 @@ impl PendingTile<'_> {
 /// Joins the simplified tiles of `dir` into one mesh, merging the border vertices at
 /// equal positions, and writes it to `output` (atomically; the format from its name).
 ///
-/// Every status is checked first, so a tile that is not done (or done for another
+/// Every status is checked first, so a tile without one (or with one for another
 /// split, or with other options than tile 0) is found before any mesh is read; then
-/// each simplified file is checked against its status as it is read. `observer` is
-/// asked [`Observer::should_stop`] before each tile.
+/// each simplified file is checked against its status as it is read. The quadrics
+/// files are not read: the merged mesh does not need them (the memory budget's merge,
+/// which does, checks them too). `observer` is asked [`Observer::should_stop`] before
+/// each tile.
 pub fn merge(
     dir: &Path,
     output: &Path,
@@ -1221,6 +1264,7 @@ fn join(
     observer: &mut dyn Observer,
 ) -> Result<(IndexedMesh, CarriedQuadrics, MergeReport), TilesError> {
     let tiles = TileDir::open(dir)?;
+    let origin = tiles.manifest.quadric_origin();
     let mut statuses: Vec<TileStatus> = Vec::with_capacity(tiles.len());
     for k in 0..tiles.len() {
         let status = tiles.status_of_this_split(k)?;
@@ -1263,12 +1307,13 @@ fn join(
         let path = dir.join(quadrics_file(k));
         let bytes = read_file(&path)?;
         let quadrics = (OutputStamp::of_bytes(&bytes) == status.quadrics_stamp)
-            .then(|| quadrics_of(&bytes, tile.mesh.vertex_count()))
+            .then(|| quadrics_of(&bytes, tile.mesh.vertex_count(), origin))
             .flatten()
             .ok_or_else(|| TilesError::file(path, Problem::SimplifiedChanged { tile: k }))?;
         welder.push_carrying(&tile, &quadrics);
     }
-    let (merged, carried) = welder.finish_carrying();
+    let (merged, quadrics) = welder.finish_carrying();
+    let carried = CarriedQuadrics { origin, quadrics };
     let report = MergeReport {
         split_id: tiles.manifest.split_id.clone(),
         options: statuses
@@ -1395,6 +1440,7 @@ mod tests {
         let dir = tmp.path().join("t");
         split(&input, &dir, TileCount::Tiles(4), &mut NoObserver).expect("split");
         let tiles = TileDir::open(&dir).expect("open");
+        let origin = tiles.manifest.quadric_origin();
         let options = ratio(0.5);
         let mut own = Vec::new();
         let mut border_positions = Vec::new();
@@ -1409,7 +1455,8 @@ mod tests {
             )
             .expect("a mesh");
             let bytes = std::fs::read(dir.join(quadrics_file(k))).expect("read");
-            let quadrics = quadrics_of(&bytes, mesh.vertex_count()).expect("one a vertex");
+            let quadrics = quadrics_of(&bytes, mesh.vertex_count(), origin).expect("one a vertex");
+            assert!(quadrics_of(&bytes, mesh.vertex_count(), origin + DVec3::X).is_none());
             assert!(quadrics
                 .iter()
                 .all(|q| q.entries().iter().all(|e| e.is_finite())));
@@ -1417,6 +1464,8 @@ mod tests {
             border_positions.extend_from_slice(&mesh.positions[..status.border_vertices]);
         }
         let (merged, carried, report) = merge_carrying(&dir, &mut NoObserver).expect("merge");
+        assert_eq!(carried.origin, origin);
+        let carried = carried.quadrics;
         assert_eq!(carried.len(), merged.vertex_count());
         assert_eq!(report.vertices_out, merged.vertex_count());
         let kept: Vec<Quadric> = carried.iter().copied().filter(is_carried).collect();

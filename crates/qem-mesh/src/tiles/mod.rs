@@ -37,7 +37,7 @@ pub mod budget;
 pub mod jobs;
 
 use crate::clean::{coordinate_bits, weld_in_place};
-use crate::simplify::{CarriedQuadrics, NOT_CARRIED};
+use crate::simplify::NOT_CARRIED;
 use crate::IndexedMesh;
 use qem_core::Quadric;
 use rustc_hash::FxHashMap;
@@ -457,7 +457,7 @@ pub struct Welder {
     mesh: IndexedMesh,
     /// With [`push_carrying`](Self::push_carrying), each joined vertex's quadric:
     /// [`NOT_CARRIED`] for a border vertex.
-    carried: CarriedQuadrics,
+    carried: Vec<Quadric>,
     /// The joined mesh's vertex at each border position seen so far.
     border: FxHashMap<[u64; 3], u32>,
 }
@@ -490,8 +490,8 @@ impl Welder {
             }));
     }
 
-    /// [`push`](Self::push), and `quadrics` (one per vertex of `tile`, in world units)
-    /// carried for its vertices that are not border ones: a border vertex's quadric is
+    /// [`push`](Self::push), and `quadrics` (one per vertex of `tile`) carried for its
+    /// vertices that are not border ones: a border vertex's quadric is
     /// left to the run that takes the joined mesh, which sums it from the faces around
     /// it (see [`budget`]).
     pub(crate) fn push_carrying(&mut self, tile: &Tile, quadrics: &[Quadric]) {
@@ -515,7 +515,7 @@ impl Welder {
 
     /// The joined mesh and its vertices' carried quadrics ([`NOT_CARRIED`] for a
     /// border vertex), after [`push_carrying`](Self::push_carrying).
-    pub(crate) fn finish_carrying(self) -> (IndexedMesh, CarriedQuadrics) {
+    pub(crate) fn finish_carrying(self) -> (IndexedMesh, Vec<Quadric>) {
         (self.mesh, self.carried)
     }
 }

@@ -193,8 +193,9 @@ def simplify(directory, tile=None, **options):
 def merge(directory: PathLike, output: PathLike) -> MergeReport:
     """Joins the simplified tiles of ``directory`` into one mesh, merging the border
     vertices the tiles share, and writes it to ``output`` (atomically; the format from
-    its extension). Every tile must be done, all with the same options: a tile that is
-    not raises a ``QemError`` naming its status file and the call that fixes it.
+    its extension). Every tile must be simplified, all with the same options, and its
+    simplified file unchanged since: a tile that is not raises a ``QemError`` naming the
+    file and the call that fixes it (its quadrics file is not needed here).
     Returns the merge report.
     """
     return tiles_merge(directory, output)
