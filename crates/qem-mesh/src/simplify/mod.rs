@@ -176,11 +176,11 @@ impl Carry {
 
 /// [`simplify_owned`] carrying vertex quadrics: `seed` (one per input vertex) replaces
 /// the quadrics the run would sum from the faces, and the result comes with each output
-/// vertex's quadric, in world units about `origin` (a point near the mesh). With a seed the quadrics are summed
-/// ([`QuadricMode::Sum`]): the planes behind a carried quadric are not known, so the
-/// planes a pair shares cannot be taken out of its merged quadric. Not with
-/// [`Method::Clustering`], which has no vertex quadrics to hand back (the tiles and the
-/// memory budget refuse it before any run).
+/// vertex's quadric, in world units about `origin` (a point near the mesh). With a seed
+/// the quadrics are summed ([`QuadricMode::Sum`]): the planes behind a carried quadric
+/// are not known, so the planes a pair shares cannot be taken out of its merged
+/// quadric. Not with [`Method::Clustering`], which has no vertex quadrics to hand
+/// back (the tiles and the memory budget refuse it before any run).
 pub(crate) fn simplify_carrying(
     mesh: IndexedMesh,
     options: &SimplifyOptions,
