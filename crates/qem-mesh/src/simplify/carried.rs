@@ -189,6 +189,51 @@ mod tests {
         }
     }
 
+    /// The cleaning's weld sums the carried quadrics of the input vertices it merges,
+    /// and a vertex merged with one that carries none carries none (the run then sums
+    /// its quadric from its faces, which the uncarried vertex's planes are among).
+    #[test]
+    fn welded_vertices_sum_their_quadrics_and_an_uncarried_one_wins() {
+        use crate::clean::{clean, CleanOptions};
+        // Two triangles of a soup sharing an edge: inputs 1 and 4, and 2 and 3, are
+        // the same points.
+        let soup = IndexedMesh::new(
+            vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [1.0, 1.0, 0.0],
+            ],
+            vec![[0, 1, 2], [3, 4, 5]],
+        );
+        let cleaned = clean(&soup, &CleanOptions::DEFAULT);
+        assert_eq!(cleaned.mesh.vertex_count(), 4);
+        let map = &cleaned.vertex_map;
+        assert_eq!((map[1], map[2]), (map[4], map[3]));
+        let point = |i: usize| Quadric::from_point(DVec3::from_array(soup.positions[i]), 1.0);
+        let mut quadrics: Vec<Quadric> = (0..6).map(point).collect();
+        quadrics[3] = NOT_CARRIED;
+        let seed = CarriedQuadrics {
+            origin: DVec3::ZERO,
+            quadrics,
+        };
+        let by_cleaned = by_cleaned_vertex(seed.clone(), &cleaned);
+        assert_eq!(by_cleaned.quadrics.len(), 4);
+        assert_eq!(by_cleaned.quadrics[map[1] as usize], point(1) + point(4));
+        assert!(!is_carried(&by_cleaned.quadrics[map[2] as usize]));
+        assert_eq!(by_cleaned.quadrics[map[0] as usize], point(0));
+        // Nothing merged: the seed as it is.
+        let welded = cleaned.mesh.clone();
+        let again = clean(&welded, &CleanOptions::DEFAULT);
+        let seed = CarriedQuadrics {
+            origin: DVec3::ZERO,
+            quadrics: (0..4).map(point).collect(),
+        };
+        assert_eq!(by_cleaned_vertex(seed.clone(), &again), seed);
+    }
+
     /// A run that contracts nothing hands back, for each vertex, the quadric it was
     /// seeded with (through both frames and the engine's vertex order), with no
     /// border plane added on top; an unseeded vertex gets the quadric the run sums
