@@ -69,9 +69,11 @@ pub use relaxation::{Constraint, Relaxation, RelaxationStep};
 pub use replay::StoreReplay;
 pub use report::{Refusals, Simplified, SimplifyError, SimplifyReport, StopReason, Timings};
 
-#[cfg(test)]
+#[cfg(all(test, feature = "io"))]
 pub(crate) use carried::is_carried;
-pub(crate) use carried::{CarriedQuadrics, NOT_CARRIED};
+pub(crate) use carried::CarriedQuadrics;
+#[cfg(feature = "io")]
+pub(crate) use carried::NOT_CARRIED;
 
 use crate::clean::{clean, CleanOptions, Cleaned};
 use crate::IndexedMesh;
@@ -181,6 +183,8 @@ impl Carry {
 /// are not known, so the planes a pair shares cannot be taken out of its merged
 /// quadric. Not with [`Method::Clustering`], which has no vertex quadrics to hand
 /// back (the tiles and the memory budget refuse it before any run).
+// Outside the tests only the tile jobs call it, and they need `io`.
+#[cfg_attr(not(feature = "io"), allow(dead_code))]
 pub(crate) fn simplify_carrying(
     mesh: IndexedMesh,
     options: &SimplifyOptions,

@@ -37,8 +37,10 @@ pub mod budget;
 pub mod jobs;
 
 use crate::clean::{coordinate_bits, weld_in_place};
+#[cfg(feature = "io")]
 use crate::simplify::NOT_CARRIED;
 use crate::IndexedMesh;
+#[cfg(feature = "io")]
 use qem_core::Quadric;
 use rustc_hash::FxHashMap;
 use std::cmp::Ordering;
@@ -456,7 +458,8 @@ impl Tile {
 pub struct Welder {
     mesh: IndexedMesh,
     /// With [`push_carrying`](Self::push_carrying), each joined vertex's quadric:
-    /// [`NOT_CARRIED`] for a border vertex.
+    /// [`NOT_CARRIED`] for a border vertex. (Only the tile jobs, with `io`, carry.)
+    #[cfg(feature = "io")]
     carried: Vec<Quadric>,
     /// The joined mesh's vertex at each border position seen so far.
     border: FxHashMap<[u64; 3], u32>,
@@ -494,6 +497,7 @@ impl Welder {
     /// vertices that are not border ones: a border vertex's quadric is
     /// left to the run that takes the joined mesh, which sums it from the faces around
     /// it (see [`budget`]).
+    #[cfg(feature = "io")]
     pub(crate) fn push_carrying(&mut self, tile: &Tile, quadrics: &[Quadric]) {
         let before = self.mesh.positions.len();
         self.push(tile);
@@ -515,6 +519,7 @@ impl Welder {
 
     /// The joined mesh and its vertices' carried quadrics ([`NOT_CARRIED`] for a
     /// border vertex), after [`push_carrying`](Self::push_carrying).
+    #[cfg(feature = "io")]
     pub(crate) fn finish_carrying(self) -> (IndexedMesh, Vec<Quadric>) {
         (self.mesh, self.carried)
     }
