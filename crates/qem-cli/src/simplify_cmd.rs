@@ -100,7 +100,10 @@ pub fn parse_size(s: &str) -> Result<u64, String> {
         .parse()
         .map_err(|_| format!("{s}: not a size (e.g. 500M, 4G, or a number of bytes)"))?;
     let bytes = value * scale;
-    if !(bytes >= 1.0 && bytes < 2f64.powi(63)) {
+    if bytes >= 2f64.powi(63) {
+        return Err(format!("{s}: too large (at most 8 EiB)"));
+    }
+    if bytes.is_nan() || bytes < 1.0 {
         return Err(format!("{s}: a size must be at least one byte"));
     }
     Ok(bytes as u64)
@@ -257,11 +260,12 @@ fn material_files_of(input: &Path, output: &Path, result: &Simplified) -> Materi
     copy_beside(input, output, &result.mesh.attributes.material_libraries)
 }
 
-/// What became of the input's attributes (`input`, as [`AttributesJson::names`] gives
-/// them) in `result`, written to `output`.
 /// Why an attribute the simplification did not keep is missing, without tiles.
 const CLUSTERING_KEEPS_POSITIONS: &str = "vertex clustering keeps positions only";
 
+/// What became of the input's attributes (`input`, as [`AttributesJson::names`] gives
+/// them) in `result`, written to `output`; `lost` is why one the simplification did
+/// not keep is missing.
 fn attributes_of(
     input: Vec<String>,
     result: &Simplified,
@@ -437,9 +441,10 @@ mod tests {
         assert_eq!(parse_size("4GiB"), Ok(4 << 30));
         assert_eq!(parse_size("1.5k"), Ok(1536));
         assert_eq!(parse_size(" 2T "), Ok(2 << 40));
-        for bad in ["", "M", "4X", "-1G", "0", "NaN", "1e30T", "0.5"] {
+        for bad in ["", "M", "4X", "-1G", "0", "NaN", "0.5"] {
             assert!(parse_size(bad).is_err(), "{bad}");
         }
+        assert!(parse_size("1e30T").unwrap_err().contains("too large"));
     }
 
     /// Asks to stop as soon as the cleaning ends, as Ctrl-C pressed then would.

@@ -1141,11 +1141,9 @@ impl PendingTile<'_> {
     /// triangles spanning from border to border, far from the surface (BENCHMARKS.md,
     /// "Tiles": the dragon at ratio 0.01 in 8 tiles against 2).
     pub fn crowding(&self) -> Option<Crowding> {
-        let triangles = self.tile.mesh.triangle_count();
         let target = match self.options.options.target {
-            Target::Ratio(r) => (r * triangles as f64) as usize,
-            Target::Triangles(n) => n,
             Target::None => return None,
+            t => t.triangles_for(self.tile.mesh.triangle_count()),
         };
         let locked = self.locked.len();
         (target < 2 * locked).then_some(Crowding {
