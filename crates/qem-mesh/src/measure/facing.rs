@@ -60,8 +60,11 @@ impl TriangleBvh {
         // test then finds no triangle within a NaN distance.)
         let reach = radius2.sqrt();
         let widen = |x: f64| (x.abs() + reach) * CUBE_WIDENING + f64::from(f32::MIN_POSITIVE);
-        let cube_lo = p.map(|x| (x - reach - widen(x)) as f32);
-        let cube_hi = p.map(|x| (x + reach + widen(x)) as f32);
+        // Relative to the boxes' origin (the leaves below take `p` itself); the
+        // difference's rounding is far below `reach`, which holds `slack2`.
+        let boxed = self.relative(p);
+        let cube_lo = boxed.map(|x| (x - reach - widen(x)) as f32);
+        let cube_hi = boxed.map(|x| (x + reach + widen(x)) as f32);
         let unit = unit_direction(normal);
         let mut stack = NodeStack::with(0u32);
         while let Some(w) = stack.pop() {
