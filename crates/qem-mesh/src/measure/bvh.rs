@@ -1402,9 +1402,9 @@ mod tests {
                     for entry in start..start + count {
                         for corner in bvh.corners.get(bvh.triangle_of(entry)) {
                             let relative = bvh.relative(corner);
-                            for k in 0..3 {
-                                assert!(f64::from(node.lo[k][i]) <= relative[k]);
-                                assert!(relative[k] <= f64::from(node.hi[k][i]));
+                            for (k, &x) in relative.iter().enumerate() {
+                                assert!(f64::from(node.lo[k][i]) <= x);
+                                assert!(x <= f64::from(node.hi[k][i]));
                             }
                             exact.grow(relative);
                         }
