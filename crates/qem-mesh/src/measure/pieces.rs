@@ -9,7 +9,8 @@
 //! and 10 wide), the orientation check's facing-away search tested about 2,900
 //! triangles per query, most of them in leaves that a sliver's box had stretched over
 //! the query point; the simplification took about 7.3 s with the check (2.9 s with
-//! pieces) and 0.08 s without.
+//! pieces of a sixty-fourth of the diagonal, 4.1 s on a later build; 1.6 s with pieces
+//! down to a thousandth, [`FINEST_FRACTION`]) and 0.08 s without.
 //!
 //! The cure is the one of Ernst and Greiner's early split clipping ("Early Split
 //! Clipping for Bounding Volume Hierarchies", IEEE Symposium on Interactive Ray
@@ -34,14 +35,26 @@ use rayon::prelude::*;
 /// gains nothing; a sliver ten times longer than wide, laid diagonally, has about 10.
 pub(super) const THIN_RATIO: f64 = 8.0;
 
-/// A piece should reach at most about this fraction of the mesh's diagonal (its box's
-/// half surface at most the square of that): smaller pieces would only add nodes
-/// where the triangles around are smaller still. Only triangles at least twice that
-/// long are cut, which no triangle of a scan of more than a few thousand triangles is.
+/// Only a triangle whose box reaches more than about this fraction of the mesh's
+/// diagonal (its box's half surface above the square of that) is cut, which no
+/// triangle of a scan of more than a few thousand triangles is.
 const PIECE_FRACTION: f64 = 1.0 / 64.0;
 
+/// A triangle that is cut is cut into pieces that reach about this fraction of the
+/// diagonal (their boxes' half surfaces about the square of that), or fewer when
+/// [`THIN_RATIO`] asks for fewer.
+///
+/// Why so fine: the facing-away search's ball is far smaller than the triangles cut.
+/// On `mf_generic_twin_7081_left` at ratio 0.1 it averaged 1.7e-4 of the diagonal
+/// (2.9 units); with pieces of a sixty-fourth (265 units) a search still tested about
+/// 1,285 leaf entries, most of them slivers facing away beyond the ball, and 274 with
+/// pieces of a thousandth. The simplification took 4.1 s, then 1.6 s (the same output);
+/// a 4,096th gained nothing more. The pieces count against the budget
+/// ([`PIECES_PER_TRIANGLE`], [`EXTRA_PIECES`]).
+const FINEST_FRACTION: f64 = 1.0 / 1024.0;
+
 /// At most this many pieces per triangle (it fits the `u8` counts).
-pub(super) const MAX_PIECES: usize = 64;
+pub(super) const MAX_PIECES: usize = 255;
 
 /// At most this many pieces in all, per triangle of the mesh: the memory bound. Each
 /// piece costs a leaf entry (4 bytes) and a share of the nodes (about 18 bytes); if
@@ -49,6 +62,11 @@ pub(super) const MAX_PIECES: usize = 64;
 /// fan caps, half the triangles are slivers across the caps, and 7 pieces each (the
 /// cap this gives) cut the box overlap near the rim about 7 times.
 const PIECES_PER_TRIANGLE: usize = 4;
+
+/// Pieces allowed beyond [`PIECES_PER_TRIANGLE`] a triangle, whatever the mesh's size:
+/// at most about 23 MB more, where a small CAD mesh asks for many (the twin above
+/// asks for about a million: with a quarter of that allowed, 3.0 s instead of 1.6 s).
+const EXTRA_PIECES: usize = 1 << 20;
 
 /// The half surface of the box of `corners` (0 for a point). `f64::min` and `max`
 /// pass NaN over, so a NaN corner does not make it NaN: callers check the corners.
@@ -77,26 +95,32 @@ pub(super) fn piece_counts(
     if n < 2 || n.saturating_mul(PIECES_PER_TRIANGLE) > u32::MAX as usize {
         return None;
     }
-    // A piece's box may reach `largest` (by half surface).
+    // A triangle whose box is larger than `largest` is cut, into pieces of about
+    // `finest` (by half surface).
     let largest = (diagonal * PIECE_FRACTION).powi(2);
-    if !largest.is_finite() || largest <= 0.0 {
+    let finest = (diagonal * FINEST_FRACTION).powi(2);
+    if !largest.is_finite() || largest <= 0.0 || finest <= 0.0 {
         return None;
     }
     let counts: Vec<u8> = (0..n)
         .into_par_iter()
-        .map(|t| wanted_pieces(&corners_of(t), largest))
+        .map(|t| wanted_pieces(&corners_of(t), largest, finest))
         .collect();
     let wanted: usize = counts.iter().map(|&k| usize::from(k)).sum();
     if wanted == n {
         return None;
     }
-    Some(within_budget(counts, n * PIECES_PER_TRIANGLE))
+    Some(within_budget(
+        counts,
+        n * PIECES_PER_TRIANGLE + EXTRA_PIECES,
+    ))
 }
 
-/// The pieces `corners` asks for: enough that each piece's box is within
-/// [`THIN_RATIO`] of its area and within `largest`, whichever needs fewer (cutting
-/// into `k` slabs shrinks each piece's box about `k²` times and its area `k` times).
-fn wanted_pieces(corners: &[P3; 3], largest: f64) -> u8 {
+/// The pieces `corners` asks for: none (1) when its box is within `largest`; else
+/// enough that each piece's box is within [`THIN_RATIO`] of its area and within
+/// `finest`, whichever needs fewer (cutting into `k` slabs shrinks each piece's box
+/// about `k²` times and its area `k` times).
+fn wanted_pieces(corners: &[P3; 3], largest: f64, finest: f64) -> u8 {
     // A triangle with a NaN or infinite corner stays whole: the searches never find it,
     // and pieces would only spend the budget (and could move a mesh off the whole-
     // triangle build for one bad triangle).
@@ -110,7 +134,7 @@ fn wanted_pieces(corners: &[P3; 3], largest: f64) -> u8 {
     let [a, b, c] = *corners;
     let area = 0.5 * length(cross(sub(b, a), sub(c, a)));
     let by_shape = box_area / (THIN_RATIO * area);
-    let by_size = (box_area / largest).sqrt();
+    let by_size = (box_area / finest).sqrt();
     // A zero-area triangle (a needle) gives an infinite shape count: its size decides.
     let k = by_shape.min(by_size).floor();
     if k >= 2.0 {
@@ -262,7 +286,10 @@ mod tests {
         let counts = counts_of(&corners).expect("the long sliver is cut");
         assert!(counts[..100].iter().all(|&k| k == 1));
         assert_eq!(counts[101], 1);
-        assert!(counts[100] >= 2, "{}", counts[100]);
+        // Cut down to about a thousandth of the diagonal (580 pieces), capped at
+        // `MAX_PIECES`: more than the 4 a triangle of the budget's share, which
+        // `EXTRA_PIECES` allows a small mesh.
+        assert_eq!(usize::from(counts[100]), MAX_PIECES);
         // No thin triangle at all: nothing is cut.
         assert_eq!(counts_of(&corners[..100]), None);
         // The long sliver with a NaN corner stays whole.
