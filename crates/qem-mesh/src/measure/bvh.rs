@@ -231,6 +231,13 @@ impl WideNode {
         lanes: 0,
     };
 
+    /// The leaf entries of child `i`, when it is a leaf child.
+    fn leaf_entries(&self, i: usize) -> Option<std::ops::Range<usize>> {
+        let count = usize::from(self.leaf_count[i]);
+        let first = self.child[i] as usize;
+        (count > 0).then(|| first..first + count)
+    }
+
     pub(super) fn set_child(&mut self, i: usize, position: &Box32, normals: &NormalBox) {
         for k in 0..3 {
             self.lo[k][i] = position.lo[k];
@@ -1039,14 +1046,12 @@ fn fill_boxes(
 ) {
     nodes.par_iter_mut().for_each(|node| {
         for i in 0..usize::from(node.lanes) {
-            let count = usize::from(node.leaf_count[i]);
-            if count == 0 {
+            let Some(entries) = node.leaf_entries(i) else {
                 continue;
-            }
-            let first = node.child[i] as usize;
+            };
             let mut normals = Box32::EMPTY;
             let mut bounds = Aabb::EMPTY;
-            for e in first..first + count {
+            for e in entries {
                 let ([a, b, c], (lo, hi)) = entry(e);
                 bounds.add(&Aabb { lo, hi });
                 let normal = cross(sub(b, a), sub(c, a));
@@ -1393,13 +1398,11 @@ mod tests {
             // (checked without pieces, where an entry is a whole triangle).
             for node in (bvh.nodes.iter()).filter(|_| !pieces) {
                 for i in 0..usize::from(node.lanes) {
-                    let count = usize::from(node.leaf_count[i]);
-                    if count == 0 {
+                    let Some(entries) = node.leaf_entries(i) else {
                         continue;
-                    }
-                    let start = node.child[i] as usize;
+                    };
                     let mut exact = Aabb::EMPTY;
-                    for entry in start..start + count {
+                    for entry in entries {
                         for corner in bvh.corners.get(bvh.triangle_of(entry)) {
                             let relative = bvh.relative(corner);
                             for (k, &x) in relative.iter().enumerate() {
