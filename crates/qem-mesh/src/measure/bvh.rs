@@ -322,9 +322,9 @@ pub struct TriangleBvh {
     /// What the boxes are relative to: a box bound is `f32` of the coordinate minus
     /// this, rounded outward, and a query point is moved by it before it meets a box
     /// (the exact tests at the leaves take the points as they are). Zero along each
-    /// axis on which the mesh's box reaches or nearly reaches zero, so that the
-    /// boxes of such a mesh (the simplifier's, in its normalised frame) are the bits
-    /// they were before there was an origin.
+    /// axis on which the mesh's box reaches zero or lies nearer to it than its own
+    /// length, so that the boxes of such a mesh (the simplifier's, in its normalised
+    /// frame) are the bits they were before there was an origin.
     pub(super) origin: P3,
 }
 
