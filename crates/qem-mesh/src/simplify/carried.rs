@@ -1,6 +1,6 @@
 //! [`CarriedQuadrics`]: vertex quadrics carried from one run into another on the same
 //! surface (the tiles of a memory budget, then the run that finishes their merged
-//! mesh, [`crate::tiles::budget`]).
+//! mesh, `tiles::budget`, feature `io`).
 //!
 //! Why: a mesh simplified in two runs loses the input surface between them if the
 //! second run sums its quadrics from the first run's faces. On the dragon at ratio
@@ -17,7 +17,7 @@ use qem_core::{DVec3, Quadric};
 pub(crate) struct CarriedQuadrics {
     /// The point the quadrics are about, in world units: near the mesh, so that they
     /// keep their precision whatever its coordinates (the tiles of a split use the
-    /// centre of their centroids' box, [`crate::tiles::jobs::Manifest::quadric_origin`]).
+    /// centre of their centroids' box, `tiles::jobs::Manifest::quadric_origin`).
     pub origin: DVec3,
     /// One per vertex; [`NOT_CARRIED`] for a vertex whose quadric the run sums from
     /// its faces as usual.

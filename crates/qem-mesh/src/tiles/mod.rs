@@ -3,7 +3,7 @@
 //!
 //! This is the geometry of `qem tiles split | simplify | merge` (and of the
 //! out-of-core and distributed runs built on it); the files, the manifest and the
-//! bookkeeping of which tile is done are [`jobs`] (feature `io`), which the command and
+//! bookkeeping of which tile is done are `tiles::jobs` (feature `io`), which the command and
 //! the Python package both call.
 //!
 //! - [`Tiling::new`] welds the vertices with bit-identical positions (so an STL soup,
