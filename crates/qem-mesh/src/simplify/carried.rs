@@ -8,7 +8,6 @@
 //! against one run's 0.39%; the second run starting from the first's quadrics gave
 //! 0.34% (BENCHMARKS.md, "Under a memory budget").
 
-use crate::clean::Cleaned;
 use qem_core::{DVec3, Quadric};
 
 /// Vertex quadrics in world units about `origin` ([`qem_core::Frame::quadric_to_world`]),
@@ -50,14 +49,15 @@ pub(crate) fn is_carried(q: &Quadric) -> bool {
     !q.c.is_nan()
 }
 
-/// `seed` (one per input vertex) by the cleaned mesh's vertex: the quadrics of input
-/// vertices welded into one are summed; a cleaned vertex is [`NOT_CARRIED`] when any of
-/// its input vertices is not (its faces' planes would be lost in the carried ones'
-/// quadric: the run sums its quadric from its faces instead). When the cleaning
-/// merged and dropped nothing, the seed is returned as it is, not copied.
-pub(super) fn by_cleaned_vertex(seed: CarriedQuadrics, cleaned: &Cleaned) -> CarriedQuadrics {
-    let map = &cleaned.vertex_map;
-    let n = cleaned.mesh.vertex_count();
+/// `seed` (one per vertex of a mesh) by the vertex of its cleaned mesh, of `n`
+/// vertices, where `map` ([`Cleaned::vertex_map`](crate::clean::Cleaned::vertex_map)) takes each vertex: the quadrics of
+/// vertices welded into one are summed, those of vertices the cleaning removed
+/// ([`Cleaned::REMOVED`](crate::clean::Cleaned::REMOVED)) dropped; a cleaned vertex is [`NOT_CARRIED`] when any of its
+/// vertices is not (its faces' planes would be lost in the carried ones' quadric: the
+/// run sums its quadric from its faces instead). When the cleaning merged and dropped
+/// nothing, the seed is returned as it is, not copied. (Both ways: a run's input
+/// vertices into its cleaned mesh, and its output's before the output's cleaning.)
+pub(super) fn by_cleaned_vertex(seed: CarriedQuadrics, map: &[u32], n: usize) -> CarriedQuadrics {
     if map.len() == n && map.iter().enumerate().all(|(i, &to)| to as usize == i) {
         return seed;
     }
@@ -194,7 +194,7 @@ mod tests {
     /// its quadric from its faces, which the uncarried vertex's planes are among).
     #[test]
     fn welded_vertices_sum_their_quadrics_and_an_uncarried_one_wins() {
-        use crate::clean::{clean, CleanOptions};
+        use crate::clean::{clean, CleanOptions, Cleaned};
         // Two triangles of a soup sharing an edge: inputs 1 and 4, and 2 and 3, are
         // the same points.
         let soup = IndexedMesh::new(
@@ -219,7 +219,7 @@ mod tests {
             origin: DVec3::ZERO,
             quadrics,
         };
-        let by_cleaned = by_cleaned_vertex(seed.clone(), &cleaned);
+        let by_cleaned = by_cleaned_vertex(seed.clone(), map, cleaned.mesh.vertex_count());
         assert_eq!(by_cleaned.quadrics.len(), 4);
         assert_eq!(by_cleaned.quadrics[map[1] as usize], point(1) + point(4));
         assert!(!is_carried(&by_cleaned.quadrics[map[2] as usize]));
@@ -231,7 +231,18 @@ mod tests {
             origin: DVec3::ZERO,
             quadrics: (0..4).map(point).collect(),
         };
-        assert_eq!(by_cleaned_vertex(seed.clone(), &again), seed);
+        assert_eq!(
+            by_cleaned_vertex(seed.clone(), &again.vertex_map, again.mesh.vertex_count()),
+            seed
+        );
+        // A vertex the cleaning removed is dropped.
+        let removed = [0, Cleaned::REMOVED, 1];
+        let seed = CarriedQuadrics {
+            origin: DVec3::ZERO,
+            quadrics: (0..3).map(point).collect(),
+        };
+        let kept = by_cleaned_vertex(seed, &removed, 2).quadrics;
+        assert_eq!(kept, vec![point(0), point(2)]);
     }
 
     /// A run that contracts nothing hands back, for each vertex, the quadric it was

@@ -79,7 +79,7 @@ use crate::clean::{clean, CleanOptions, Cleaned};
 use crate::IndexedMesh;
 use carried::by_cleaned_vertex;
 use engine::Engine;
-use qem_core::{DVec3, Frame, Quadric};
+use qem_core::{DVec3, Frame};
 use std::borrow::Cow;
 use std::time::Instant;
 
@@ -322,7 +322,8 @@ fn levels_of(
     let frame = Frame::from_points(cleaned.mesh.positions.iter().map(|p| DVec3::from_array(*p)));
     let clock = Instant::now();
     observer.phase(Phase::SettingUp);
-    let seed = carry.seed.map(|seed| by_cleaned_vertex(seed, &cleaned));
+    let seed = (carry.seed)
+        .map(|seed| by_cleaned_vertex(seed, &cleaned.vertex_map, cleaned.mesh.vertex_count()));
     let mut engine = Engine::new(&cleaned.mesh, frame, &locked, options, seed);
     timings.setup = clock.elapsed();
     if observer.should_stop() {
@@ -410,17 +411,13 @@ fn levels_of(
             faces_flipped: engine.flipped_faces(),
             timings,
         };
-        if let Some((origin, raw_quadrics)) = raw_quadrics {
-            let mut out_quadrics = vec![Quadric::ZERO; out.vertex_count()];
-            for (&to, q) in final_clean.vertex_map.iter().zip(raw_quadrics) {
-                if to != Cleaned::REMOVED {
-                    out_quadrics[to as usize] += q;
-                }
-            }
-            quadrics.push(CarriedQuadrics {
+        if let Some((origin, quadrics_of_raw)) = raw_quadrics {
+            let of_raw = CarriedQuadrics {
                 origin,
-                quadrics: out_quadrics,
-            });
+                quadrics: quadrics_of_raw,
+            };
+            let n = out.vertex_count();
+            quadrics.push(by_cleaned_vertex(of_raw, &final_clean.vertex_map, n));
         }
         results.push(Simplified { mesh: out, report });
     }

@@ -245,23 +245,12 @@ impl Manifest {
     /// precision whatever its coordinates; from the manifest, so that every tile job
     /// and the merge find the same one.
     pub fn quadric_origin(&self) -> DVec3 {
-        let mut tiles = self.tiles.iter();
-        let Some(first) = tiles.next() else {
+        if self.tiles.is_empty() {
             return DVec3::ZERO;
-        };
-        let (lo, hi) = tiles.fold(
-            (
-                DVec3::from_array(first.centroid_min),
-                DVec3::from_array(first.centroid_max),
-            ),
-            |(lo, hi), t| {
-                (
-                    lo.min(DVec3::from_array(t.centroid_min)),
-                    hi.max(DVec3::from_array(t.centroid_max)),
-                )
-            },
-        );
-        lo * 0.5 + hi * 0.5
+        }
+        let corners = (self.tiles.iter()).flat_map(|t| [t.centroid_min, t.centroid_max]);
+        let (lo, hi) = super::bounds(corners);
+        DVec3::from_array(lo) * 0.5 + DVec3::from_array(hi) * 0.5
     }
 }
 
