@@ -541,6 +541,79 @@ mod tests {
             (Some(a), Some(b)) => assert_eq!(a, b, "{what}, chunk {chunk}, sized {sized}"),
             _ => assert_eq!(parts, whole, "{what}, chunk {chunk}, sized {sized}"),
         }
+        check_streamed(data, format, chunk, sized, &whole, what);
+    }
+
+    /// Every triangle a streaming read hands on, as its corners' bits.
+    #[derive(Default)]
+    struct Collect(Vec<[[u64; 3]; 3]>);
+
+    impl crate::io::TriangleSink for Collect {
+        fn triangle(&mut self, corners: [[f64; 3]; 3]) -> Result<(), crate::io::IoError> {
+            self.0.push(corners.map(|p| p.map(f64::to_bits)));
+            Ok(())
+        }
+    }
+
+    /// A streaming read of `data` in chunks fails as the ordinary read `whole` did,
+    /// or hands on that mesh's triangles (in its order, but for triangles that waited
+    /// for their vertices) and counts its vertices.
+    fn check_streamed(
+        data: &[u8],
+        format: Format,
+        chunk: usize,
+        sized: bool,
+        whole: &Result<LoadedMesh, ReadError>,
+        what: &str,
+    ) {
+        let len = if sized || is_gzip(data) {
+            data.len() as u64
+        } else {
+            2 * data.len() as u64 + 4096
+        };
+        let mut input = Input::reader(Box::new(data), len, chunk).expect("memory reads");
+        let mut sink = Collect::default();
+        let streamed = crate::io::stream_input(&mut input, format, None, &mut sink);
+        let at = format!("{what}, chunk {chunk}, sized {sized}, streamed");
+        match (whole, streamed) {
+            (Ok(loaded), Ok(streamed)) => {
+                let mesh = &loaded.mesh;
+                let mut expected: Vec<[[u64; 3]; 3]> = mesh
+                    .triangles
+                    .iter()
+                    .map(|t| t.map(|v| mesh.positions[v as usize].map(f64::to_bits)))
+                    .collect();
+                let mut got = sink.0;
+                if got != expected {
+                    // Only triangles that waited for their vertices come out of order.
+                    got.sort_unstable();
+                    expected.sort_unstable();
+                    assert_eq!(got, expected, "{at}");
+                }
+                assert_eq!(streamed.triangles, mesh.triangle_count(), "{at}");
+                assert_eq!(streamed.vertices, mesh.vertex_count(), "{at}");
+                assert_eq!(streamed.notes, loaded.notes, "{at}");
+                assert_eq!(
+                    streamed.attributes_dropped,
+                    !mesh.attributes.is_empty(),
+                    "{at}"
+                );
+            }
+            (Err(e), Err(crate::io::StreamError::Read(s))) => {
+                // (A corrupt gzip stream's byte count depends on the chunks.)
+                let digits =
+                    |e: &ReadError| e.to_string().replace(|c: char| c.is_ascii_digit(), "");
+                assert_eq!(digits(&s), digits(e), "{at}");
+            }
+            (whole, streamed) => panic!(
+                "{at}: read {:?}, streamed {:?}",
+                whole.as_ref().map(|l| l.mesh.triangle_count()),
+                streamed.map(|s| s.triangles).map_err(|e| match e {
+                    crate::io::StreamError::Read(e) => e.to_string(),
+                    crate::io::StreamError::Sink(e) => e.to_string(),
+                })
+            ),
+        }
     }
 
     /// `data` read every way a caller can, plain and gzipped: from memory

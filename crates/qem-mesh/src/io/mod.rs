@@ -108,6 +108,7 @@ mod off;
 mod ply;
 mod stamp;
 mod stl;
+mod stream;
 mod text;
 
 use std::io::{Read, Write};
@@ -121,6 +122,8 @@ pub use atomic::{
 pub use error::{IoError, Location, ReadError, ReadErrorKind};
 use input::Input;
 pub use stamp::{fingerprint, OutputStamp};
+use stream::Triangles;
+pub use stream::{Streamed, TriangleSink};
 
 use crate::IndexedMesh;
 
@@ -339,6 +342,90 @@ fn read_plain(
     format: Format,
     external: Option<gltf::External<'_>>,
 ) -> Result<LoadedMesh, ReadError> {
+    let mut triangles = Triangles::kept();
+    let (mut mesh, notes) = parse(input, format, external, &mut triangles)?;
+    // (OBJ and glTF fill the mesh's list themselves.)
+    let kept = triangles.into_kept();
+    if !kept.is_empty() {
+        mesh.triangles = kept;
+    }
+    let loaded = LoadedMesh { mesh, notes };
+    // The parsers report most problems with a place; this is the safety net that makes
+    // the documented guarantee hold whatever they missed.
+    loaded
+        .mesh
+        .validate()
+        .map_err(|e| ReadError::mesh(None, e))?;
+    Ok(loaded)
+}
+
+/// What a streaming read ends with: the reader's result, or the error to give (the
+/// sink's, or one of the data, which the caller names the file in).
+pub(crate) enum StreamError {
+    Read(ReadError),
+    Sink(IoError),
+}
+
+impl From<ReadError> for StreamError {
+    fn from(e: ReadError) -> Self {
+        StreamError::Read(e)
+    }
+}
+
+/// [`read_input`]'s streaming counterpart (see [`stream_path`]).
+pub(crate) fn stream_input(
+    input: &mut Input<'_>,
+    format: Format,
+    external: Option<gltf::External<'_>>,
+    sink: &mut dyn TriangleSink,
+) -> Result<Streamed, StreamError> {
+    let read = stream_plain(input, format, external, sink);
+    // A gzip error anywhere in the stream wins over what the reader found.
+    input.finish()?;
+    read
+}
+
+fn stream_plain(
+    input: &mut Input<'_>,
+    format: Format,
+    external: Option<gltf::External<'_>>,
+    sink: &mut dyn TriangleSink,
+) -> Result<Streamed, StreamError> {
+    let mut triangles = Triangles::streamed(sink);
+    let (mesh, notes) = parse(input, format, external, &mut triangles)?;
+    if !mesh.triangles.is_empty() {
+        // OBJ and glTF are read whole (their readers do not hand triangles on yet):
+        // checked as an ordinary read is, then handed on.
+        mesh.validate().map_err(|e| ReadError::mesh(None, e))?;
+        for &t in &mesh.triangles {
+            triangles.push(t, &mesh.positions);
+        }
+    }
+    let triangle_count = triangles.len();
+    let vertices =
+        triangles
+            .finish(&mesh.positions)
+            .map_err(|end| match end.into_read_error() {
+                Ok(e) => StreamError::Read(e),
+                Err(e) => StreamError::Sink(e),
+            })?;
+    Ok(Streamed {
+        vertices,
+        triangles: triangle_count,
+        notes,
+        attributes_dropped: !mesh.attributes.is_empty(),
+    })
+}
+
+/// Parses `input` in `format`: the mesh and what was passed over. PLY, STL and OFF
+/// give their triangles to `triangles` (the mesh's list stays empty); OBJ and glTF
+/// fill the mesh's list.
+fn parse(
+    input: &mut Input<'_>,
+    format: Format,
+    external: Option<gltf::External<'_>>,
+    triangles: &mut Triangles<'_>,
+) -> Result<(IndexedMesh, ReadNotes), ReadError> {
     input.fill(1)?;
     if input.window().is_empty() {
         return Err(ReadError::new(ReadErrorKind::Empty, None));
@@ -353,19 +440,12 @@ fn read_plain(
     // it) from all its bytes.
     let mesh = match format {
         Format::Obj => obj::read(input, &mut notes)?,
-        Format::Ply => ply::read(input, &mut notes)?,
-        Format::Stl => stl::read(input, &mut notes)?,
-        Format::Off => off::read(input, &mut notes)?,
+        Format::Ply => ply::read(input, &mut notes, triangles)?,
+        Format::Stl => stl::read(input, &mut notes, triangles)?,
+        Format::Off => off::read(input, &mut notes, triangles)?,
         Format::Gltf | Format::Glb => gltf::read(&input.rest()?, format, external, &mut notes)?,
     };
-    let loaded = LoadedMesh { mesh, notes };
-    // The parsers report most problems with a place; this is the safety net that makes
-    // the documented guarantee hold whatever they missed.
-    loaded
-        .mesh
-        .validate()
-        .map_err(|e| ReadError::mesh(None, e))?;
-    Ok(loaded)
+    Ok((mesh, notes))
 }
 
 /// Reads a mesh file; the format comes from the name ([`Format::from_path`]),
@@ -408,6 +488,88 @@ pub fn read_path(path: &Path) -> Result<LoadedMesh, IoError> {
         return Err(file_err(source));
     }
     read.map_err(read_err)
+}
+
+/// Reads a mesh file as [`read_path`] does, but hands each triangle to `sink` as it is
+/// read instead of keeping a list of them (see [`TriangleSink`] for what is held
+/// meanwhile: for PLY, OFF and STL, the vertices at most; OBJ and glTF are read whole
+/// for now, then handed on). It fails exactly when [`read_path`] fails, with the same
+/// error, or when the sink fails, with the sink's; either way the sink may have been
+/// given triangles first, which the caller must discard. On success the sink has seen
+/// every triangle of the mesh [`read_path`] gives, as the positions of its corners,
+/// in the file's order (a triangle that names a vertex not read yet comes once it is).
+///
+/// ```
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// use qem_mesh::io::{stream_path, write_path, IoError, TriangleSink};
+/// use qem_mesh::IndexedMesh;
+/// struct Count(usize);
+/// impl TriangleSink for Count {
+///     fn triangle(&mut self, _corners: [[f64; 3]; 3]) -> Result<(), IoError> {
+///         self.0 += 1;
+///         Ok(())
+///     }
+/// }
+/// let dir = tempfile::tempdir()?;
+/// let path = dir.path().join("two.ply");
+/// let mesh = IndexedMesh::new(
+///     vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]],
+///     vec![[0, 1, 2], [1, 3, 2]],
+/// );
+/// write_path(&path, &mesh)?;
+/// let mut count = Count(0);
+/// let streamed = stream_path(&path, &mut count)?;
+/// assert_eq!((count.0, streamed.triangles, streamed.vertices), (2, 2, 4));
+/// # Ok(()) }
+/// ```
+pub fn stream_path(path: &Path, sink: &mut dyn TriangleSink) -> Result<Streamed, IoError> {
+    let read_err = |source| IoError::Read {
+        path: path.to_path_buf(),
+        source,
+    };
+    let format = Format::from_path(path).map_err(read_err)?;
+    let file_err = |source| IoError::File {
+        path: path.to_path_buf(),
+        action: "read",
+        source,
+    };
+    let mut input = std::fs::File::open(path)
+        .and_then(Input::file)
+        .map_err(file_err)?;
+    let dir = directory_of(path);
+    let open = |uri: &str, len: usize| read_buffer_file(&dir.join(uri), len);
+    let read = stream_input(&mut input, format, Some(&open), sink);
+    if let Some(source) = input.take_file_error() {
+        return Err(file_err(source));
+    }
+    match read {
+        Ok(streamed) => Ok(streamed),
+        Err(StreamError::Read(e)) => Err(read_err(e)),
+        Err(StreamError::Sink(e)) => Err(e),
+    }
+}
+
+/// [`stream_path`] for data in memory in `format` (gzip data decompressed first), as
+/// [`read_bytes`] reads it: the same errors, the sink's aside.
+pub fn stream_bytes(
+    bytes: &[u8],
+    format: Format,
+    sink: &mut dyn TriangleSink,
+) -> Result<Streamed, StreamBytesError> {
+    match stream_input(&mut Input::detect(bytes), format, None, sink) {
+        Ok(streamed) => Ok(streamed),
+        Err(StreamError::Read(e)) => Err(StreamBytesError::Read(e)),
+        Err(StreamError::Sink(e)) => Err(StreamBytesError::Sink(e)),
+    }
+}
+
+/// Why [`stream_bytes`] failed.
+#[derive(Debug)]
+pub enum StreamBytesError {
+    /// The data was refused, as [`read_bytes`] refuses it.
+    Read(ReadError),
+    /// The sink refused a triangle.
+    Sink(IoError),
 }
 
 /// The first `len` bytes of a glTF buffer file; fewer when the file is shorter, which

@@ -45,13 +45,21 @@ use smallvec::SmallVec;
 
 use super::channels::{colours_on_faces, per_vertex, unit_colours};
 use super::input::Input;
+use super::stream::Triangles;
 use super::text::{self, capacity_for, parse_f32, parse_f64, parse_i64, show, words, TextStream};
 use super::{sniff_start, starts_solid, Format, Location, ReadError, ReadNotes, SNIFF_HEAD};
 use crate::attributes::{Attributes, Channel, ChannelKind};
 use crate::{IndexedMesh, InputError, MAX_ELEMENTS};
 
 /// Reads an OFF file a line at a time as it arrives.
-pub(crate) fn read(input: &mut Input<'_>, notes: &mut ReadNotes) -> Result<IndexedMesh, ReadError> {
+///
+/// The triangles go to `triangles` (see [`Triangles`]); the mesh returned holds the
+/// positions and the attributes, its triangle list empty.
+pub(crate) fn read(
+    input: &mut Input<'_>,
+    notes: &mut ReadNotes,
+    triangles: &mut Triangles<'_>,
+) -> Result<IndexedMesh, ReadError> {
     // What `sniff` needs to say what data that is not OFF looks like: its start, and
     // whether its first line with content starts with "solid" (`next_content` notes it).
     input.fill(SNIFF_HEAD)?;
@@ -237,7 +245,7 @@ pub(crate) fn read(input: &mut Input<'_>, notes: &mut ReadNotes) -> Result<Index
             }
         }
     }
-    let mut triangles = Vec::with_capacity(capacity_for(nf, lines.could_hold(), 8));
+    triangles.reserve(capacity_for(nf, lines.could_hold(), 8));
     let mut corners: Vec<u32> = Vec::new();
     let mut face_colours: Vec<f32> = Vec::new();
     let mut face_dimension = None;
@@ -288,7 +296,7 @@ pub(crate) fn read(input: &mut Input<'_>, notes: &mut ReadNotes) -> Result<Index
             ));
         }
         let first_triangle = triangles.len();
-        fan(&corners, &mut triangles);
+        fan(&corners, triangles, &positions);
         // A face colour is 3 or 4 numbers after the indices; one number (a colour map
         // index, meaningless without the map) or none leaves the face without one.
         let rest: SmallVec<[&[u8]; 4]> = w.take(5).collect();
@@ -305,15 +313,16 @@ pub(crate) fn read(input: &mut Input<'_>, notes: &mut ReadNotes) -> Result<Index
             }
             let index = (face_colours.len() / rest.len()) as u32;
             for tok in &rest {
-                face_colours.push(attribute(
-                    tok,
-                    &format!("face {f}"),
-                    "colour component",
-                    at(no),
-                )?);
+                let value = attribute(tok, &format!("face {f}"), "colour component", at(no))?;
+                // (A streaming read checks the values but keeps no per-face data.)
+                if !triangles.is_streamed() {
+                    face_colours.push(value);
+                }
             }
-            triangle_colours.resize(first_triangle, Channel::MISSING);
-            triangle_colours.resize(triangles.len(), index);
+            if !triangles.is_streamed() {
+                triangle_colours.resize(first_triangle, Channel::MISSING);
+                triangle_colours.resize(triangles.len(), index);
+            }
         }
     }
     while next_content(&mut lines, &mut solid)?.is_some() {
@@ -321,7 +330,7 @@ pub(crate) fn read(input: &mut Input<'_>, notes: &mut ReadNotes) -> Result<Index
     }
     notes.non_utf8_lines += lines.non_utf8_lines();
     let mut channels = Vec::new();
-    let per_vertex = |kind, values| Channel::new(kind, values, triangles.clone());
+    let per_vertex = |kind, values| Channel::new(kind, values, triangles.kept_list().to_vec());
     if has_normal {
         channels.push(per_vertex(ChannelKind::Normal, normals));
     }
@@ -332,7 +341,7 @@ pub(crate) fn read(input: &mut Input<'_>, notes: &mut ReadNotes) -> Result<Index
         channels.push(per_vertex(ChannelKind::TexCoord, uvs));
     }
     if let Some(d) = face_dimension {
-        triangle_colours.resize(triangles.len(), Channel::MISSING);
+        triangle_colours.resize(triangles.kept_list().len(), Channel::MISSING);
         let name = if colour_dimension.is_some() {
             "face_colour"
         } else {
@@ -346,7 +355,7 @@ pub(crate) fn read(input: &mut Input<'_>, notes: &mut ReadNotes) -> Result<Index
         );
     }
     Ok(
-        IndexedMesh::new(positions, triangles).with_attributes(Attributes {
+        IndexedMesh::new(positions, Vec::new()).with_attributes(Attributes {
             channels,
             ..Attributes::default()
         }),
@@ -397,10 +406,13 @@ fn levels(mut colours: Vec<f32>) -> Vec<f32> {
     colours
 }
 
-/// Appends the fan triangulation of a polygon (first corner shared) to `out`.
-pub(crate) fn fan(corners: &[u32], out: &mut Vec<[u32; 3]>) {
+/// Adds the fan triangulation of a polygon (first corner shared) to `out`, its
+/// corners indexing `positions`.
+pub(crate) fn fan(corners: &[u32], out: &mut Triangles<'_>, positions: &[[f64; 3]]) {
     if let Some((&a, rest)) = corners.split_first() {
-        out.extend(rest.windows(2).map(|w| [a, w[0], w[1]]));
+        for w in rest.windows(2) {
+            out.push([a, w[0], w[1]], positions);
+        }
     }
 }
 

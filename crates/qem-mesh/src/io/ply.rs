@@ -58,6 +58,7 @@ use std::io::Write;
 use super::channels::{all_levels, colours_on_faces, from_level, per_vertex, to_level};
 use super::input::Input;
 use super::off::fan;
+use super::stream::Triangles;
 use super::text::{self, capacity_for, parse_f32, parse_f64, parse_i64, show, TextStream};
 use super::{sniff, sniff_input, Format, Location, ReadError, ReadErrorKind, ReadNotes};
 use crate::attributes::{Attributes, Channel, ChannelKind};
@@ -574,9 +575,9 @@ struct Values {
 }
 
 /// Mesh under construction, shared by the ascii and binary paths.
-struct Builder {
+struct Builder<'t, 's> {
     positions: Vec<[f64; 3]>,
-    triangles: Vec<[u32; 3]>,
+    triangles: &'t mut Triangles<'s>,
     /// Vertex count once the vertex element is read, for range checks while reading
     /// faces (elements may come in any order; `validate` catches the rest).
     vertex_count: Option<usize>,
@@ -591,7 +592,7 @@ struct Builder {
     triangle_faces: Vec<u32>,
 }
 
-impl Builder {
+impl Builder<'_, '_> {
     fn push_vertex(&mut self, p: [f64; 3], at: Location) -> Result<(), ReadError> {
         if !p.iter().all(|c| c.is_finite()) {
             return Err(ReadError::mesh(
@@ -642,8 +643,9 @@ impl Builder {
                 self.triangles.len() as u64,
             ));
         }
-        fan(&self.corners, &mut self.triangles);
-        if !self.face_values.is_empty() {
+        fan(&self.corners, self.triangles, &self.positions);
+        // (A streaming read keeps no per-face data.)
+        if !self.face_values.is_empty() && !self.triangles.is_streamed() {
             // faces < MAX_ELEMENTS (the header's count is checked), so it fits a u32.
             self.triangle_faces.extend(std::iter::repeat_n(
                 self.faces as u32,
@@ -708,7 +710,14 @@ pub(crate) const HEADER_PREFIX: usize = 1 << 16;
 
 /// Reads a PLY file as it arrives: the header whole, then a binary body whole records
 /// at a time, an ASCII one a token at a time.
-pub(crate) fn read(input: &mut Input<'_>, notes: &mut ReadNotes) -> Result<IndexedMesh, ReadError> {
+///
+/// The triangles go to `triangles` (see [`Triangles`]); the mesh returned holds the
+/// positions and the attributes, its triangle list empty.
+pub(crate) fn read(
+    input: &mut Input<'_>,
+    notes: &mut ReadNotes,
+    triangles: &mut Triangles<'_>,
+) -> Result<IndexedMesh, ReadError> {
     input.fill(b"ply\r\n".len())?;
     if !starts_ply(input.window()) {
         return Err(not_ply(sniff_input(input)?));
@@ -746,7 +755,7 @@ pub(crate) fn read(input: &mut Input<'_>, notes: &mut ReadNotes) -> Result<Index
                     Encoding::Ascii => Body::Ascii(TextStream::new(input, header.body_line)),
                     Encoding::Little | Encoding::Big => Body::Binary(input),
                 };
-                return read_body(&head, &header, body, notes);
+                return read_body(&head, &header, body, notes, triangles);
             }
             Some(Err(e)) if !goes_on => return Err(e),
             _ => want = window.len().saturating_mul(2),
@@ -771,6 +780,7 @@ fn read_body(
     header: &Header,
     mut body: Body,
     notes: &mut ReadNotes,
+    triangles: &mut Triangles<'_>,
 ) -> Result<IndexedMesh, ReadError> {
     notes.non_utf8_lines += text::non_utf8_lines(head);
     // Which element is which, and the plans: the vertex element's first, so a face
@@ -813,7 +823,7 @@ fn read_body(
     };
     let mut b = Builder {
         positions: Vec::new(),
-        triangles: Vec::new(),
+        triangles,
         vertex_count: None,
         corners: Vec::new(),
         faces: 0,
@@ -847,7 +857,7 @@ fn read_body(
         for (c, v) in planned.zip(values) {
             // A vertex channel's value i is vertex i's; a face channel's is face i's.
             let corners = match side {
-                Side::Vertex => b.triangles.clone(),
+                Side::Vertex => b.triangles.kept_list().to_vec(),
                 _ => b.triangle_faces.iter().map(|&f| [f; 3]).collect(),
             };
             channels.push(Channel {
@@ -860,7 +870,7 @@ fn read_body(
         }
     }
     Ok(
-        IndexedMesh::new(b.positions, b.triangles).with_attributes(Attributes {
+        IndexedMesh::new(b.positions, Vec::new()).with_attributes(Attributes {
             channels,
             ..Attributes::default()
         }),
@@ -890,7 +900,7 @@ struct Reading<'e, 'a> {
 fn read_ascii_element(
     tok: &mut TextStream<'_, '_>,
     reading: &Reading,
-    b: &mut Builder,
+    b: &mut Builder<'_, '_>,
 ) -> Result<(), ReadError> {
     let Reading { el, roles, side } = *reading;
     let is_vertex = roles.iter().any(|r| matches!(r, Role::Coord(_)));
@@ -1099,7 +1109,7 @@ fn read_binary_element(
     input: &mut Input<'_>,
     reading: &Reading,
     big: bool,
-    b: &mut Builder,
+    b: &mut Builder<'_, '_>,
 ) -> Result<(), ReadError> {
     let fixed: Option<usize> = reading
         .el
@@ -1126,7 +1136,7 @@ fn read_fixed(
     reading: &Reading,
     stride: usize,
     big: bool,
-    b: &mut Builder,
+    b: &mut Builder<'_, '_>,
 ) -> Result<(), ReadError> {
     let Reading { el, roles, side } = *reading;
     let start = input.offset();
@@ -1195,7 +1205,7 @@ fn read_variable(
     input: &mut Input<'_>,
     reading: &Reading,
     big: bool,
-    b: &mut Builder,
+    b: &mut Builder<'_, '_>,
 ) -> Result<(), ReadError> {
     let el = reading.el;
     if reading.roles.iter().any(|r| matches!(r, Role::Indices)) {
@@ -1268,7 +1278,7 @@ fn read_record(
     cur: &mut Cursor,
     reading: &Reading,
     r: usize,
-    b: &mut Builder,
+    b: &mut Builder<'_, '_>,
 ) -> Result<(), ReadError> {
     let Reading { el, roles, side } = *reading;
     let truncated = |cur: &Cursor| {

@@ -15,6 +15,7 @@
 use std::io::Write;
 
 use super::input::Input;
+use super::stream::Triangles;
 use super::text::{self, capacity_for, parse_f64, show, TextStream};
 use super::{sniff, strip_bom, Format, Location, ReadError, ReadNotes, BOM, SNIFF_HEAD};
 use crate::{IndexedMesh, InputError, MAX_ELEMENTS};
@@ -28,7 +29,15 @@ const START: usize = BOM.len() + SNIFF_HEAD;
 
 /// Reads an STL file as it arrives: binary STL whole records at a time, ASCII STL a
 /// token at a time.
-pub(crate) fn read(input: &mut Input<'_>, notes: &mut ReadNotes) -> Result<IndexedMesh, ReadError> {
+///
+/// The triangles go to `triangles` (see [`Triangles`]; a streaming read forgets each
+/// facet's vertices once its triangles are handed on); the mesh returned holds the
+/// positions kept, its triangle list empty.
+pub(crate) fn read(
+    input: &mut Input<'_>,
+    notes: &mut ReadNotes,
+    triangles: &mut Triangles<'_>,
+) -> Result<IndexedMesh, ReadError> {
     input.fill(START)?;
     let window = input.window();
     let (text, bom) = strip_bom(window);
@@ -41,7 +50,7 @@ pub(crate) fn read(input: &mut Input<'_>, notes: &mut ReadNotes) -> Result<Index
     let looks_like = sniff(text);
     let ascii = decided && is_text(looks_like, text);
     match count {
-        Some(n) if decided && !ascii => read_binary(input, n, looks_like),
+        Some(n) if decided && !ascii => read_binary(input, n, looks_like, triangles),
         // Text is binary STL all the same if its size is that of a binary file of the
         // count at byte 80, which only the end of the data tells. Read as it arrives
         // when the data cannot be that big (`could_hold` is at least its size); a
@@ -60,7 +69,7 @@ pub(crate) fn read(input: &mut Input<'_>, notes: &mut ReadNotes) -> Result<Index
             input.consume(if bom { BOM.len() } else { 0 });
             let mut tok = TextStream::new(input, 1);
             tok.count_non_utf8();
-            let read = read_ascii(&mut tok, notes);
+            let read = read_ascii(&mut tok, notes, triangles);
             // Counted before `count_rest`, which skips what is left without counting
             // it (a last line without a line break went uncounted that way).
             let non_utf8 = tok.non_utf8_lines();
@@ -71,7 +80,7 @@ pub(crate) fn read(input: &mut Input<'_>, notes: &mut ReadNotes) -> Result<Index
             notes.non_utf8_lines += non_utf8;
             Ok(mesh)
         }
-        _ => read_all(&input.rest()?, notes),
+        _ => read_all(&input.rest()?, notes, triangles),
     }
 }
 
@@ -82,7 +91,11 @@ fn is_text(looks_like: Option<&str>, text: &[u8]) -> bool {
 }
 
 /// Reads an STL file from all its bytes.
-fn read_all(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, ReadError> {
+fn read_all(
+    bytes: &[u8],
+    notes: &mut ReadNotes,
+    triangles: &mut Triangles<'_>,
+) -> Result<IndexedMesh, ReadError> {
     let count = bytes
         .get(80..84)
         .and_then(|b| b.try_into().ok())
@@ -91,14 +104,14 @@ fn read_all(bytes: &[u8], notes: &mut ReadNotes) -> Result<IndexedMesh, ReadErro
     let looks_like = sniff(text);
     match count {
         Some(n) if expected_len(n) == bytes.len() as u64 || !is_text(looks_like, text) => {
-            read_binary(&mut Input::plain(bytes), n, looks_like)
+            read_binary(&mut Input::plain(bytes), n, looks_like, triangles)
         }
         _ if is_text(looks_like, text) => {
             notes.byte_order_mark = bom;
             let mut input = Input::plain(text);
             let mut tok = TextStream::new(&mut input, 1);
             tok.count_non_utf8();
-            let mesh = read_ascii(&mut tok, notes)?;
+            let mesh = read_ascii(&mut tok, notes, triangles)?;
             notes.non_utf8_lines += tok.non_utf8_lines();
             Ok(mesh)
         }
@@ -137,13 +150,15 @@ fn read_binary(
     input: &mut Input<'_>,
     n: u32,
     looks_like: Option<&'static str>,
+    triangles: &mut Triangles<'_>,
 ) -> Result<IndexedMesh, ReadError> {
     let too_large = n as usize > MAX_ELEMENTS;
     let count = if too_large { 0 } else { n as usize };
     input.consume(HEADER);
     let room = capacity_for(count, input.could_hold(), RECORD);
-    let mut positions = Vec::with_capacity(3 * room);
-    let mut triangles = Vec::with_capacity(room);
+    // (A streaming read holds one window's facets at a time.)
+    let mut positions = Vec::with_capacity(if triangles.is_streamed() { 0 } else { 3 * room });
+    triangles.reserve(room);
     // The first facet with a coordinate that is not finite: reported only once the
     // size says the data is binary STL.
     let mut bad = None;
@@ -157,7 +172,8 @@ fn read_binary(
         }
         if bad.is_none() {
             let at = input.offset();
-            bad = read_facets(&window[..k * RECORD], at, &mut positions, &mut triangles);
+            bad = read_facets(&window[..k * RECORD], at, &mut positions, triangles);
+            triangles.forget(&mut positions);
         }
         input.consume(k * RECORD);
         t += k;
@@ -166,7 +182,7 @@ fn read_binary(
     if len == expected_len(n) && !too_large {
         return match bad {
             Some(e) => Err(e),
-            None => Ok(IndexedMesh::new(positions, triangles)),
+            None => Ok(IndexedMesh::new(positions, Vec::new())),
         };
     }
     let binary_error = matches!(
@@ -206,7 +222,7 @@ fn read_facets(
     data: &[u8],
     at: u64,
     positions: &mut Vec<[f64; 3]>,
-    triangles: &mut Vec<[u32; 3]>,
+    triangles: &mut Triangles<'_>,
 ) -> Option<ReadError> {
     for (r, rec) in data.chunks_exact(RECORD).enumerate() {
         for k in 0..3 {
@@ -224,15 +240,15 @@ fn read_facets(
                 return Some(ReadError::mesh(
                     Some(Location::Byte(at + (r * RECORD + 12 + 12 * k) as u64)),
                     InputError::NonFiniteCoordinate {
-                        vertex: positions.len(),
+                        vertex: triangles.vertex_number(positions.len()),
                     },
                 ));
             }
             positions.push(p);
         }
         // Fewer than 2^28 triangles (MAX_ELEMENTS), so 3t + 2 fits a u32.
-        let b = (3 * triangles.len()) as u32;
-        triangles.push([b, b + 1, b + 2]);
+        let b = triangles.vertex_number(positions.len() - 3) as u32;
+        triangles.push([b, b + 1, b + 2], positions);
     }
     None
 }
@@ -279,11 +295,11 @@ impl Word {
 fn read_ascii(
     tok: &mut TextStream<'_, '_>,
     notes: &mut ReadNotes,
+    triangles: &mut Triangles<'_>,
 ) -> Result<IndexedMesh, ReadError> {
     // The last line counted in `notes.skipped_lines`, so a line is counted once.
     let mut skipped_line = 0usize;
     let mut positions: Vec<[f64; 3]> = Vec::new();
-    let mut triangles = Vec::new();
     // Index in `positions` of the current facet's first vertex, while inside a facet.
     let mut facet_start: Option<usize> = None;
     let mut facets = 0usize;
@@ -329,16 +345,13 @@ fn read_ascii(
                 return Err(ReadError::mesh(
                     Some(at),
                     InputError::NonFiniteCoordinate {
-                        vertex: positions.len(),
+                        vertex: triangles.vertex_number(positions.len()),
                     },
                 ));
             }
-            if positions.len() >= 3 * MAX_ELEMENTS {
-                return Err(ReadError::too_large(
-                    at,
-                    "STL vertices:",
-                    positions.len() as u64,
-                ));
+            let vertices = triangles.vertex_number(positions.len());
+            if vertices >= 3 * MAX_ELEMENTS {
+                return Err(ReadError::too_large(at, "STL vertices:", vertices as u64));
             }
             positions.push(p);
         } else if word == Word::EndFacet {
@@ -352,10 +365,15 @@ fn read_ascii(
                     format!("facet {facets} has {n} vertices; a facet needs at least 3"),
                 ));
             }
-            let a = start as u32;
+            // (Vertex numbers fit a u32: fewer than 3 · 2^28 vertices, checked above.)
+            let forgotten = triangles.vertex_number(0);
+            let number = |k: usize| (forgotten + k) as u32;
+            let a = number(start);
             for k in start + 1..positions.len() - 1 {
-                triangles.push([a, k as u32, k as u32 + 1]);
+                let t = [a, number(k), number(k) + 1];
+                triangles.push(t, &positions);
             }
+            triangles.forget(&mut positions);
             facets += 1;
         } else if word == Word::Other && skipped_line != line {
             // An exporter's extension or junk: it has no say in the geometry.
@@ -370,7 +388,7 @@ fn read_ascii(
             format!("inside facet {facets}"),
         ));
     }
-    Ok(IndexedMesh::new(positions, triangles))
+    Ok(IndexedMesh::new(positions, Vec::new()))
 }
 
 pub(crate) fn write(out: &mut impl Write, mesh: &IndexedMesh) -> std::io::Result<()> {

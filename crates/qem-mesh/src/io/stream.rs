@@ -1,0 +1,351 @@
+//! Streaming reads: each triangle handed to a [`TriangleSink`] as it is read, so that a
+//! file can be cut into pieces on disk (`qem tiles split`) without its triangle list
+//! ever being held.
+//!
+//! The readers are the ones [`read_path`](super::read_path) uses, in a mode where the
+//! triangles they make go to the sink instead of into a list ([`Triangles`]). What a
+//! streaming read still holds: PLY, OFF and OBJ keep their vertices (24 bytes each, the
+//! faces name them by number) and, for OBJ, the per-element bookkeeping its reader
+//! keeps anyway (`io::obj`'s docs); STL keeps only the facet being read; glTF is read
+//! whole, as always, and its triangles are handed on afterwards. Per-vertex attribute
+//! values are read (and checked) as by an ordinary read, then dropped; per-corner and
+//! per-face ones are not gathered.
+//!
+//! A triangle whose corners are not all known when it is read (a PLY file with its
+//! faces before its vertices, an OBJ face naming a vertex defined later in its
+//! section) waits, 12 bytes a triangle, until they are: the end of the file, the end
+//! of the OBJ section. So the sink sees the file's triangles in the file's order
+//! except for those, which follow later.
+//!
+//! The sink sees triangles before the end of the file says whether the file is valid:
+//! a streaming read that ends in an error has handed on some triangles, which the
+//! caller must discard. A read that succeeds has checked what
+//! [`IndexedMesh::validate`](crate::IndexedMesh::validate) checks of the mesh
+//! [`read_path`](super::read_path) would have returned (it fails exactly when that
+//! read fails), and the sink has seen exactly that mesh's triangles, as the positions
+//! of their corners.
+
+use super::error::{IoError, ReadError};
+use super::ReadNotes;
+use crate::input::InputError;
+use crate::MAX_ELEMENTS;
+
+/// Where a streaming read ([`stream_path`](super::stream_path)) sends each triangle.
+pub trait TriangleSink {
+    /// Takes one triangle, as its three corners' positions (in the file's corner
+    /// order). An error stops the read: it is what the read returns.
+    fn triangle(&mut self, corners: [[f64; 3]; 3]) -> Result<(), IoError>;
+}
+
+/// What a successful streaming read saw.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Streamed {
+    /// The vertices of the mesh an ordinary read would have returned.
+    pub vertices: usize,
+    /// The triangles handed to the sink (those of that mesh).
+    pub triangles: usize,
+    /// What the reader passed over, as for an ordinary read.
+    pub notes: ReadNotes,
+    /// Whether the file had attributes (texture coordinates, normals, colours,
+    /// materials, groups, channels), which a streaming read does not hand on.
+    pub attributes_dropped: bool,
+}
+
+/// The triangles a reader makes: kept in a list (an ordinary read) or handed to a sink
+/// (a streaming read).
+pub(crate) struct Triangles<'s> {
+    kept: Vec<[u32; 3]>,
+    stream: Option<Stream<'s>>,
+    /// Triangles made so far.
+    len: usize,
+}
+
+/// The streaming side of [`Triangles`].
+struct Stream<'s> {
+    sink: &'s mut dyn TriangleSink,
+    /// Triangles whose corners were not all known when made: (triangle number, corners).
+    waiting: Vec<(u32, [u32; 3])>,
+    /// The sink's first error; nothing more is handed on after it.
+    failed: Option<IoError>,
+    /// Vertices already forgotten by the reader ([`Triangles::forget`]): the
+    /// positions it passes start at this vertex number.
+    forgotten: usize,
+}
+
+impl<'s> Triangles<'s> {
+    /// An ordinary read's list.
+    pub(crate) fn kept() -> Self {
+        Triangles {
+            kept: Vec::new(),
+            stream: None,
+            len: 0,
+        }
+    }
+
+    /// A streaming read's: every triangle goes to `sink`.
+    pub(crate) fn streamed(sink: &'s mut dyn TriangleSink) -> Self {
+        Triangles {
+            kept: Vec::new(),
+            stream: Some(Stream {
+                sink,
+                waiting: Vec::new(),
+                failed: None,
+                forgotten: 0,
+            }),
+            len: 0,
+        }
+    }
+
+    /// Whether the triangles go to a sink (a streaming read).
+    pub(crate) fn is_streamed(&self) -> bool {
+        self.stream.is_some()
+    }
+
+    /// Triangles made so far.
+    #[inline]
+    pub(crate) fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Reserves room for `n` more kept triangles (nothing when streaming).
+    pub(crate) fn reserve(&mut self, n: usize) {
+        if self.stream.is_none() {
+            self.kept.reserve(n);
+        }
+    }
+
+    /// Adds triangle `t`, whose corners index `positions` (offset by the vertices
+    /// forgotten so far): kept, handed on, or set to wait when a corner is not in
+    /// `positions` yet.
+    #[inline]
+    pub(crate) fn push(&mut self, t: [u32; 3], positions: &[[f64; 3]]) {
+        let number = self.len as u32;
+        self.len += 1;
+        let Some(stream) = &mut self.stream else {
+            self.kept.push(t);
+            return;
+        };
+        if stream.failed.is_some() {
+            return;
+        }
+        let local = t.map(|i| (i as usize).checked_sub(stream.forgotten));
+        match local.map(|i| i.and_then(|i| positions.get(i).copied())) {
+            [Some(a), Some(b), Some(c)] => {
+                if let Err(e) = stream.sink.triangle([a, b, c]) {
+                    stream.failed = Some(e);
+                }
+            }
+            _ => stream.waiting.push((number, t)),
+        }
+    }
+
+    /// Hands on the waiting triangles whose corners are all in `positions` now, in
+    /// the order they were made (a reader calls this once the vertices they wait for
+    /// are read).
+    pub(crate) fn settle(&mut self, positions: &[[f64; 3]]) {
+        let Some(stream) = &mut self.stream else {
+            return;
+        };
+        let mut still = Vec::new();
+        for (number, t) in std::mem::take(&mut stream.waiting) {
+            let corners = t.map(|i| {
+                (i as usize)
+                    .checked_sub(stream.forgotten)
+                    .and_then(|i| positions.get(i).copied())
+            });
+            match corners {
+                [Some(a), Some(b), Some(c)] if stream.failed.is_none() => {
+                    if let Err(e) = stream.sink.triangle([a, b, c]) {
+                        stream.failed = Some(e);
+                    }
+                }
+                [Some(_), Some(_), Some(_)] => {}
+                _ => still.push((number, t)),
+            }
+        }
+        stream.waiting = still;
+    }
+
+    /// For a reader whose triangles never name an earlier facet's vertices (STL):
+    /// when streaming, the vertices in `positions` are handed on with their
+    /// triangles already, so they are forgotten (`positions` is cleared; later
+    /// indices count them still). Does nothing to an ordinary read.
+    pub(crate) fn forget(&mut self, positions: &mut Vec<[f64; 3]>) {
+        if let Some(stream) = &mut self.stream {
+            stream.forgotten += positions.len();
+            positions.clear();
+        }
+    }
+
+    /// The number of vertex `local` of a reader's positions, counting the vertices
+    /// forgotten before them (for messages and counts).
+    pub(crate) fn vertex_number(&self, local: usize) -> usize {
+        local + self.stream.as_ref().map_or(0, |s| s.forgotten)
+    }
+
+    /// The kept list (empty for a streaming read).
+    pub(crate) fn kept_list(&self) -> &[[u32; 3]] {
+        &self.kept
+    }
+
+    /// The kept list, taken (empty for a streaming read).
+    pub(crate) fn into_kept(self) -> Vec<[u32; 3]> {
+        self.kept
+    }
+
+    /// The end of a streaming read whose reader gave `positions` (the mesh's, with
+    /// the vertices it forgot not among them): hands on what waited, then checks
+    /// what [`IndexedMesh::validate`](crate::IndexedMesh::validate) checks of the
+    /// mesh an ordinary read gives, and the sink's error. Returns the vertex count.
+    pub(crate) fn finish(mut self, positions: &[[f64; 3]]) -> Result<usize, StreamEnd> {
+        self.settle(positions);
+        let Some(stream) = self.stream else {
+            return Ok(positions.len());
+        };
+        let vertex_count = stream.forgotten + positions.len();
+        for (what, count) in [("vertices", vertex_count), ("triangles", self.len)] {
+            if count > MAX_ELEMENTS {
+                return Err(StreamEnd::Input(InputError::TooLarge {
+                    what,
+                    count,
+                    limit: MAX_ELEMENTS,
+                }));
+            }
+        }
+        if self.len == 0 {
+            return Err(StreamEnd::Input(InputError::NoTriangles));
+        }
+        if let Some(vertex) = positions
+            .iter()
+            .position(|p| !p.iter().all(|c| c.is_finite()))
+        {
+            return Err(StreamEnd::Input(InputError::NonFiniteCoordinate {
+                vertex: vertex + stream.forgotten,
+            }));
+        }
+        if let Some(&(face, t)) = stream.waiting.first() {
+            let index = t
+                .into_iter()
+                .find(|&i| i as usize >= vertex_count)
+                .unwrap_or(t[0]);
+            return Err(StreamEnd::Input(InputError::IndexOutOfRange {
+                face: face as usize,
+                index,
+                vertex_count,
+            }));
+        }
+        match stream.failed {
+            Some(e) => Err(StreamEnd::Sink(e)),
+            None => Ok(vertex_count),
+        }
+    }
+}
+
+/// Why a streaming read that its reader finished still fails.
+pub(crate) enum StreamEnd {
+    /// The mesh breaks a rule of [`IndexedMesh::validate`](crate::IndexedMesh::validate).
+    Input(InputError),
+    /// The sink refused a triangle.
+    Sink(IoError),
+}
+
+impl StreamEnd {
+    /// As the error of a read of the data (the sink's error is the caller's to give).
+    pub(crate) fn into_read_error(self) -> Result<ReadError, IoError> {
+        match self {
+            StreamEnd::Input(e) => Ok(ReadError::mesh(None, e)),
+            StreamEnd::Sink(e) => Err(e),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::{read_bytes, stream_bytes, Format, StreamBytesError};
+
+    /// Every triangle handed on, as its corners.
+    #[derive(Default)]
+    struct Collect {
+        corners: Vec<[[f64; 3]; 3]>,
+        /// Refuse the triangle of this number.
+        refuse: Option<usize>,
+    }
+
+    impl TriangleSink for Collect {
+        fn triangle(&mut self, corners: [[f64; 3]; 3]) -> Result<(), IoError> {
+            if self.refuse == Some(self.corners.len()) {
+                return Err(IoError::File {
+                    path: "spill".into(),
+                    action: "write",
+                    source: std::io::Error::other("disk full"),
+                });
+            }
+            self.corners.push(corners);
+            Ok(())
+        }
+    }
+
+    /// A PLY file whose faces come before its vertices: each triangle waits for its
+    /// corners, and comes once the vertices are read, in order.
+    #[test]
+    fn triangles_before_their_vertices_wait_for_them() {
+        let ply =
+            b"ply\nformat ascii 1.0\nelement face 2\nproperty list uchar int vertex_indices\n\
+            element vertex 4\nproperty float x\nproperty float y\nproperty float z\nend_header\n\
+            3 0 1 2\n3 2 1 3\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n";
+        let mut sink = Collect::default();
+        let streamed = stream_bytes(ply, Format::Ply, &mut sink).unwrap();
+        assert_eq!((streamed.vertices, streamed.triangles), (4, 2));
+        let p = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [1.0, 1.0, 0.0],
+        ];
+        assert_eq!(sink.corners, vec![[p[0], p[1], p[2]], [p[2], p[1], p[3]]]);
+        assert_eq!(
+            read_bytes(ply, Format::Ply).unwrap().mesh.triangle_count(),
+            2
+        );
+    }
+
+    /// The sink's error is the read's, and nothing is handed on after it.
+    #[test]
+    fn a_sink_error_ends_the_read() {
+        let off = b"OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n";
+        let mut sink = Collect {
+            refuse: Some(1),
+            ..Collect::default()
+        };
+        match stream_bytes(off, Format::Off, &mut sink) {
+            Err(StreamBytesError::Sink(e)) => {
+                assert_eq!(e.to_string(), "spill: cannot write: disk full")
+            }
+            other => panic!("expected the sink's error, got {other:?}"),
+        }
+        assert_eq!(sink.corners.len(), 1);
+    }
+
+    /// A streaming read of an STL soup keeps no vertex between facets, and the
+    /// checks of the whole mesh still hold: no triangle is an error, as for a read.
+    #[test]
+    fn stl_facets_are_forgotten_and_an_empty_file_is_refused() {
+        let stl = b"solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n\
+            vertex 0 1 0\nendloop\nendfacet\nfacet normal 0 0 1\nouter loop\nvertex 1 0 0\n\
+            vertex 1 1 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid t\n";
+        let mut sink = Collect::default();
+        let streamed = stream_bytes(stl, Format::Stl, &mut sink).unwrap();
+        assert_eq!((streamed.vertices, streamed.triangles), (6, 2));
+        assert_eq!(
+            sink.corners[1],
+            [[1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]]
+        );
+        let empty = b"solid t\nendsolid t\n";
+        let read = read_bytes(empty, Format::Stl).unwrap_err().to_string();
+        match stream_bytes(empty, Format::Stl, &mut Collect::default()) {
+            Err(StreamBytesError::Read(e)) => assert_eq!(e.to_string(), read),
+            other => panic!("expected a read error, got {other:?}"),
+        }
+    }
+}
