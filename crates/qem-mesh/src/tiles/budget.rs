@@ -43,7 +43,8 @@
 //! 0.0274%; tiles straight to 4% gave 9.8% and 0.41% (BENCHMARKS.md, "Tiles").
 //!
 //! What holds memory at each step, besides the program: the input mesh and the
-//! split's few bytes a triangle (checked against the budget before the split); one
+//! split's sample while its triangles go to disk, then one tile of the split (checked
+//! against the budget before the split); one
 //! tile's simplification; the merged mesh and its vertices' quadrics (80 bytes a
 //! vertex, which become the finish's own quadrics); the in-core finish. The input's
 //! attributes are not carried by tiles: a run that tiles drops them (the caller is
@@ -75,15 +76,17 @@ pub const CLUSTER_BYTES_PER_TRIANGLE: u64 = 48;
 /// windows, the threads' stacks (a run on the 5,856-triangle cow peaks near 10 MB).
 pub const FIXED_BYTES: u64 = 32 << 20;
 
-/// What the split holds beside the mesh it cuts (`Tiling::new`'s documentation): the
-/// weld's 9 bytes a vertex, then the cut's 4 bytes a triangle and the border flags' 5
-/// a vertex; and one tile at a time, its mesh and its file (about 48 bytes a tile
-/// triangle). On the bench's 10M-triangle cube-sphere this gives 441 MB; the split
-/// measured 347 MB (BENCHMARKS.md, "Tiles").
-const WELD_BYTES_PER_VERTEX: u64 = 9;
-const CUT_BYTES_PER_TRIANGLE: u64 = 4;
-const BORDER_BYTES_PER_VERTEX: u64 = 5;
-const TILE_COPY_BYTES_PER_TRIANGLE: u64 = 48;
+/// What the split holds beside the mesh it cuts (`tiles::split`): while the triangles
+/// go to disk, the cut's sample (32 bytes a centroid, at most
+/// [`SAMPLE_CAP`](super::SAMPLE_CAP) of them); then, the mesh let go, the tiles' file
+/// buffers ([`BUFFER_BYTES_PER_TILE`] a tile, [`MAX_BUFFER_BYTES`] in all at most) and
+/// one tile at a time, whose positions' bits are sorted (72 bytes a tile triangle) and
+/// which is then numbered and written (about 80 bytes a tile triangle, with its file's
+/// bytes).
+const SAMPLE_BYTES_PER_TRIANGLE: u64 = 32;
+const BUFFER_BYTES_PER_TILE: u64 = 128 << 10;
+const MAX_BUFFER_BYTES: u64 = 64 << 20;
+const TILE_BYTES_PER_TRIANGLE: u64 = 80;
 
 /// The share of `room` a round aims to leave, so that the merged mesh, border strips
 /// and all, still fits.
@@ -326,17 +329,16 @@ pub fn simplify_within(
 }
 
 /// About the bytes the split of `mesh` into tiles of at most `room` triangles holds:
-/// the mesh, the weld's or the cut's arrays (the larger), and one tile's copy and file.
+/// the mesh and the cut's sample while its triangles go to disk, or (the mesh let go)
+/// the routing buffers and one tile, whichever is more.
 fn split_bytes(mesh: &IndexedMesh, room: usize) -> u64 {
     let (v, t) = (mesh.vertex_count() as u64, mesh.triangle_count() as u64);
-    let arrays =
-        (WELD_BYTES_PER_VERTEX * v).max(CUT_BYTES_PER_TRIANGLE * t + BORDER_BYTES_PER_VERTEX * v);
-    FIXED_BYTES
-        + 24 * v
-        + 12 * t
-        + attribute_bytes(mesh)
-        + arrays
-        + TILE_COPY_BYTES_PER_TRIANGLE * (room as u64).min(t)
+    let sample = SAMPLE_BYTES_PER_TRIANGLE * t.min(super::SAMPLE_CAP as u64);
+    let spilling = 24 * v + 12 * t + attribute_bytes(mesh) + sample;
+    let tiles = t.div_ceil(room.max(1) as u64);
+    let buffers = (BUFFER_BYTES_PER_TILE * (tiles + 1)).min(MAX_BUFFER_BYTES);
+    let tiling = buffers + TILE_BYTES_PER_TRIANGLE * (room as u64).min(t);
+    FIXED_BYTES + spilling.max(tiling)
 }
 
 /// The bytes of `mesh`'s attribute channels (values and corners).

@@ -38,8 +38,10 @@
 //! writer's).
 //!
 //! Nothing here holds the tiles together in memory except [`merge`], which holds the
-//! simplified mesh it writes; [`split`] reads the input whole (the readers give whole
-//! meshes, not a triangle at a time, yet).
+//! simplified mesh it writes. [`split`] streams its input to disk as it reads it and
+//! builds the tiles from there one at a time (`tiles::split`): it holds the input's
+//! vertices while reading (PLY, OFF and OBJ; STL none; OBJ and glTF are still read
+//! whole), then one tile.
 //!
 //! Errors are [`TilesError`]s that name the file; those a later step fixes say which
 //! ([`TilesError::remedy`]), for the caller to word in its own terms (a command line,
@@ -82,11 +84,12 @@
 //! # Ok(()) }
 //! ```
 
-use super::{Tile, Tiling, Welder};
+use super::split::{remove_stale_scratch, Spill, Spilled};
+use super::{Tile, Welder};
 use crate::io::{
-    directory_of, fingerprint, read_bytes, read_path, remove_stale_temporaries,
-    remove_stale_temporaries_of, write_atomically, write_json_atomically, write_path, write_to,
-    Format, IoError, OutputStamp,
+    directory_of, fingerprint, read_bytes, remove_stale_temporaries, remove_stale_temporaries_of,
+    stream_path, write_atomically, write_json_atomically, write_path, write_to, Format, IoError,
+    OutputStamp, TriangleSink,
 };
 use crate::simplify::{
     simplify_carrying, CarriedQuadrics, Length, Method, Observer, SimplifyError, SimplifyOptions,
@@ -209,7 +212,7 @@ impl Default for TileCount {
 }
 
 impl TileCount {
-    /// The number of tiles to ask of [`Tiling::new`] for `triangles` triangles.
+    /// The number of tiles to cut `triangles` triangles into.
     fn tiles_for(self, triangles: usize) -> usize {
         match self {
             TileCount::Tiles(n) => n,
@@ -267,7 +270,9 @@ pub struct InputJson {
     pub vertices: usize,
     /// Its triangles, as read (polygons split into triangles).
     pub triangles: usize,
-    /// Vertices merged into another with a bit-identical position before the cut.
+    /// Vertices not kept as such: merged into another with a bit-identical position
+    /// (`-0.0` as `+0.0`), or used by no triangle (the input's vertices less the
+    /// distinct positions its triangles use).
     pub welded_vertices: usize,
     /// Whether the input had attributes (UVs, normals, colours, materials), which the
     /// tiles do not carry.
@@ -279,7 +284,9 @@ pub struct InputJson {
 #[non_exhaustive]
 pub struct PartitionJson {
     /// `kd-median`: halves (in proportion to the tile counts on each side) at the
-    /// median triangle centroid along the axis of their largest spread.
+    /// median triangle centroid along the axis of their largest spread; the median of
+    /// a sample of the centroids, every one up to 2^20 triangles
+    /// ([`SAMPLE_CAP`](super::SAMPLE_CAP)), every `2^k`-th beyond.
     pub method: String,
     /// The tile count asked for ([`TileCount::Tiles`], or the triangles over
     /// [`TileCount::MaxTriangles`]).
@@ -678,7 +685,8 @@ fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), TilesError> {
     Ok(write_atomically(path, |f| f.write_all(bytes))?)
 }
 
-/// Reads the input whole, welds it (bit-identical positions), cuts it ([`Tiling`]), and
+/// Streams the input to disk as it reads it, cuts it into tiles as
+/// [`Tiling`](super::Tiling) cuts (vertices welded by bit-identical position), and
 /// writes the tiles and then the manifest into `dir` (created if missing). Returns the
 /// manifest.
 ///
@@ -701,7 +709,8 @@ pub fn split(
     let size_bytes = std::fs::metadata(input)
         .map_err(|e| os_error(input, "read", e))?
         .len();
-    let mesh = read_path(input)?.mesh;
+    let mut spill = Spill::create(dir)?;
+    let streamed = stream_path(input, &mut spill)?;
     if observer.should_stop() {
         return Err(TilesError::Cancelled);
     }
@@ -709,12 +718,28 @@ pub fn split(
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let input = SplitInput {
+    let source = Source {
         name,
         size_bytes,
-        mesh,
+        vertices: streamed.vertices,
+        attributes_dropped: streamed.attributes_dropped,
     };
-    write_tiles(input, dir, &manifest_path, count, observer)
+    write_tiles(
+        source,
+        spill.finish()?,
+        dir,
+        &manifest_path,
+        count,
+        observer,
+    )
+}
+
+/// What the manifest says of a split's input besides its triangles.
+struct Source {
+    name: String,
+    size_bytes: u64,
+    vertices: usize,
+    attributes_dropped: bool,
 }
 
 /// A mesh to [`split_mesh`], already in memory, with what the manifest says of the file
@@ -732,7 +757,9 @@ pub struct SplitInput {
 /// [`split`] for a mesh already read: the same files as [`split`] of the file it was
 /// read from, given that file's name and size. For a caller that reads the input
 /// anyway (the memory budget of [`super::budget`] decides on it), so it is not read
-/// twice.
+/// twice. The mesh is let go once its triangles are on disk. Triangles with an index
+/// out of range are left out (a mesh that passed
+/// [`IndexedMesh::validate`](crate::IndexedMesh::validate) has none).
 pub fn split_mesh(
     input: SplitInput,
     dir: &Path,
@@ -740,7 +767,33 @@ pub fn split_mesh(
     observer: &mut dyn Observer,
 ) -> Result<Manifest, TilesError> {
     let manifest_path = clear_for_split(dir)?;
-    write_tiles(input, dir, &manifest_path, count, observer)
+    let SplitInput {
+        name,
+        size_bytes,
+        mesh,
+    } = input;
+    let mut spill = Spill::create(dir)?;
+    for t in &mesh.triangles {
+        let corners = t.map(|v| mesh.positions.get(v as usize).copied());
+        if let [Some(a), Some(b), Some(c)] = corners {
+            spill.triangle([a, b, c])?;
+        }
+    }
+    let source = Source {
+        name,
+        size_bytes,
+        vertices: mesh.vertex_count(),
+        attributes_dropped: !mesh.attributes.is_empty(),
+    };
+    drop(mesh);
+    write_tiles(
+        source,
+        spill.finish()?,
+        dir,
+        &manifest_path,
+        count,
+        observer,
+    )
 }
 
 /// Creates `dir` if missing and removes its old manifest (and stale temporaries)
@@ -748,6 +801,7 @@ pub fn split_mesh(
 fn clear_for_split(dir: &Path) -> Result<PathBuf, TilesError> {
     std::fs::create_dir_all(dir).map_err(|e| os_error(dir, "create", e))?;
     let _ = remove_stale_temporaries(dir);
+    remove_stale_scratch(dir);
     let manifest_path = dir.join(MANIFEST_NAME);
     match std::fs::remove_file(&manifest_path) {
         Err(e) if e.kind() != ErrorKind::NotFound => {
@@ -758,38 +812,38 @@ fn clear_for_split(dir: &Path) -> Result<PathBuf, TilesError> {
     Ok(manifest_path)
 }
 
-/// The split's work once the input is in memory: the cut, the tiles, the manifest.
+/// The split's work once the input is on disk: the cut, the tiles, the manifest.
 fn write_tiles(
-    input: SplitInput,
+    source: Source,
+    spilled: Spilled,
     dir: &Path,
     manifest_path: &Path,
     count: TileCount,
     observer: &mut dyn Observer,
 ) -> Result<Manifest, TilesError> {
-    let SplitInput {
+    let Source {
         name,
         size_bytes,
-        mesh,
-    } = input;
-    let triangles = mesh.triangle_count();
+        vertices,
+        attributes_dropped,
+    } = source;
+    let triangles = spilled.triangles as usize;
     let requested = count.tiles_for(triangles);
-    let vertices = mesh.vertex_count();
-    let attributes_dropped = !mesh.attributes.is_empty();
-    let tiling = Tiling::new(mesh, requested);
-    let (bbox_min, bbox_max) = tiling
-        .welded_mesh()
-        .bounding_box()
-        .unwrap_or(([0.0; 3], [0.0; 3]));
-    let mut tiles = Vec::with_capacity(tiling.len());
-    for k in 0..tiling.len() {
+    let (bbox_min, bbox_max) = match spilled.bbox {
+        (lo, hi) if triangles > 0 => (lo, hi),
+        _ => ([0.0; 3], [0.0; 3]),
+    };
+    let routed = spilled.route(requested)?;
+    let welded_vertices = vertices.saturating_sub(routed.distinct_positions);
+    let mut tiles = Vec::with_capacity(routed.len());
+    for k in 0..routed.len() {
         if observer.should_stop() {
             return Err(TilesError::Cancelled);
         }
-        let tile = tiling.tile(k);
+        let (tile, (centroid_min, centroid_max)) = routed.tile(k)?;
         let path = dir.join(tile_file(k));
         let bytes = ply_bytes(&tile.mesh, &path)?;
         write_bytes(&path, &bytes)?;
-        let (centroid_min, centroid_max) = tiling.centroid_box(k);
         tiles.push(TileEntry {
             index: k,
             file: tile_file(k),
@@ -810,7 +864,7 @@ fn write_tiles(
             size_bytes,
             vertices,
             triangles,
-            welded_vertices: tiling.welded_vertices(),
+            welded_vertices,
             attributes_dropped,
         },
         partition: PartitionJson {
@@ -1318,6 +1372,7 @@ fn join(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::read_path;
     use crate::simplify::{is_carried, NoObserver};
     use std::collections::BTreeMap;
 
@@ -1338,6 +1393,53 @@ mod tests {
         let path = dir.join("grid.ply");
         write_path(&path, &IndexedMesh::new(positions, triangles)).expect("write the grid");
         path
+    }
+
+    /// The split of a file, streamed to disk, gives the tiles of
+    /// [`Tiling`](super::super::Tiling) on the mesh read from it, as PLY and as an STL
+    /// soup (whose facets share no vertex), and the same manifest counts.
+    #[test]
+    fn the_streamed_split_gives_the_tiling_of_the_read_mesh() {
+        let tmp = tempfile::tempdir().expect("a temporary directory");
+        let ply = grid_file(tmp.path(), 23);
+        let mesh = read_path(&ply).expect("read").mesh;
+        let stl = tmp.path().join("grid.stl");
+        write_path(&stl, &mesh).expect("write the soup");
+        for (input, tiles) in [(&ply, 5), (&stl, 7), (&ply, 1)] {
+            let read = read_path(input).expect("read").mesh;
+            let dir = tmp.path().join("t");
+            let manifest =
+                split(input, &dir, TileCount::Tiles(tiles), &mut NoObserver).expect("split");
+            let tiling = super::super::Tiling::new(read.clone(), tiles);
+            assert_eq!(manifest.tiles.len(), tiling.len());
+            assert_eq!(manifest.input.vertices, read.vertex_count());
+            assert_eq!(manifest.input.welded_vertices, tiling.welded_vertices());
+            let dir = TileDir::open(&dir).expect("open");
+            for k in 0..tiling.len() {
+                let expected = tiling.tile(k);
+                let file = dir.path().join(tile_file(k));
+                let got = read_path(&file).expect("read the tile").mesh;
+                assert_eq!(
+                    got.positions, expected.mesh.positions,
+                    "tile {k} of {input:?}"
+                );
+                assert_eq!(
+                    got.triangles, expected.mesh.triangles,
+                    "tile {k} of {input:?}"
+                );
+                let entry = &manifest.tiles[k];
+                assert_eq!(entry.border_vertices, expected.border_vertices);
+                let boxed = tiling.centroid_box(k);
+                assert_eq!((entry.centroid_min, entry.centroid_max), boxed);
+            }
+            // Nothing of the split's scratch is left.
+            let left: Vec<_> = std::fs::read_dir(dir.path())
+                .expect("list")
+                .filter_map(|e| e.ok())
+                .filter(|e| e.file_name().to_string_lossy().starts_with(".qem-split-"))
+                .collect();
+            assert!(left.is_empty(), "{left:?}");
+        }
     }
 
     fn ratio(r: f64) -> TileOptions {
@@ -1499,7 +1601,7 @@ mod tests {
         .expect("split");
         assert_eq!(
             (manifest.split_id.as_str(), env!("CARGO_PKG_VERSION")),
-            ("bf6fc3ec", "0.1.0"),
+            ("7b6d7b55", "0.1.0"),
             "a new version changes the split id: update both"
         );
     }

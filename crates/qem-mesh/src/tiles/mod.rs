@@ -8,13 +8,17 @@
 //!
 //! - [`Tiling::new`] welds the vertices with bit-identical positions (so an STL soup,
 //!   whose facets share no vertex, has its border found by position), and cuts the
-//!   triangles into tiles by a k-d bisection of their centroids: the set (or part of
-//!   it) whose centroids spread furthest along an axis is cut at the median along that
-//!   axis, so tiles get equal triangle counts (within one) wherever the surface lies
-//!   in its bounding box. A regular grid over the box would leave most cells of a
-//!   surface empty and the others uneven.
+//!   triangles into tiles by a k-d bisection of their centroids ([`Cut`]): the set (or
+//!   part of it) whose centroids spread furthest along an axis is cut at the median
+//!   along that axis, so tiles get equal triangle counts wherever the surface lies in
+//!   its bounding box. A regular grid over the box would leave most cells of a surface
+//!   empty and the others uneven. The medians are those of a sample of the centroids
+//!   ([`Sample`]): every centroid up to [`SAMPLE_CAP`] triangles (equal counts within
+//!   one), beyond that every `2^k`-th, so that the split of a file streamed from disk
+//!   (`jobs::split`) needs no list of every triangle and cuts exactly as this does.
 //! - [`Tiling::tile`] gives one tile as its own mesh, its **border vertices first**: a
-//!   border vertex is one that triangles of more than one tile use.
+//!   border vertex is one that triangles of more than one tile use. Each group is
+//!   numbered in the order the tile's triangles (in input order) first use it.
 //!   [`Tile::locked_vertices`] are those and their neighbours in the tile: locking them
 //!   (`SimplifyOptions::with_locked_vertices`) leaves every triangle at the border as
 //!   it is, so the tiles still meet, edge for edge, after each is simplified on its
@@ -30,6 +34,8 @@
 //!
 //! Everything is deterministic: the same mesh and tile count give the same tiles, bit
 //! for bit (ties between equal centroid coordinates go by triangle number).
+#[cfg(feature = "io")]
+mod split;
 
 #[cfg(feature = "io")]
 pub mod budget;
@@ -43,7 +49,6 @@ use crate::IndexedMesh;
 #[cfg(feature = "io")]
 use qem_core::Quadric;
 use rustc_hash::FxHashMap;
-use std::cmp::Ordering;
 
 /// A mesh's triangles cut into spatial tiles (see the [module docs](self)).
 #[derive(Clone, Debug)]
@@ -73,13 +78,14 @@ pub struct Tile {
 
 impl Tiling {
     /// Cuts `mesh` into `tiles` tiles (at least 1, at most one per triangle) of equal
-    /// triangle counts (within one). Attributes are not carried: tiles hold positions
-    /// and triangles only.
+    /// triangle counts (within one up to [`SAMPLE_CAP`] triangles; about equal beyond,
+    /// see the module docs). Attributes are not carried: tiles hold positions and
+    /// triangles only.
     ///
     /// Memory: besides the mesh (24 bytes a vertex, 12 a triangle), welded in place,
-    /// the weld holds 9 bytes a vertex, the cut 4 bytes a triangle (its number; the
-    /// centroids are computed when compared, not kept) and the border flags 5 bytes a
-    /// vertex. `mesh` is expected to have passed
+    /// the weld holds 9 bytes a vertex, the cut's sample 32 bytes a triangle up to
+    /// [`SAMPLE_CAP`] of them, the tiles' lists 4 bytes a triangle and the border flags
+    /// 5 bytes a vertex. `mesh` is expected to have passed
     /// [`IndexedMesh::validate`]; triangles with an index out of range are dropped
     /// rather than trusted.
     ///
@@ -104,20 +110,40 @@ impl Tiling {
         let welded = weld_in_place(&mut mesh);
         let count = mesh.triangles.len();
         let tiles = tiles.clamp(1, count.max(1));
-        let centroids = Centroids(&mesh);
-        let mut triangles: Vec<u32> = (0..count as u32).collect();
-        let mut ends = Vec::with_capacity(tiles);
-        bisect(&mut triangles, 0, tiles, centroids, &mut ends);
-        let mut starts = Vec::with_capacity(tiles + 1);
-        starts.push(0);
-        starts.extend_from_slice(&ends);
-        let mut boxes = Vec::with_capacity(tiles);
-        for w in starts.windows(2) {
-            let part = &mut triangles[w[0]..w[1]];
-            // Input order inside a tile: the file's locality, and one answer.
-            part.sort_unstable();
-            boxes.push(bounds(part.iter().map(|&t| centroids.of(t))));
+        let corners = |t: &[u32; 3]| t.map(|v| mesh.positions[v as usize]);
+        let mut sample = Sample::new();
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            sample.offer(t as u64, centroid(&corners(tri)));
         }
+        let cut = Cut::new(sample, tiles);
+        // Each triangle's tile, then the tiles' lists, each in input order (the file's
+        // locality, and one answer).
+        let tile_of: Vec<u32> = (mesh.triangles.iter().enumerate())
+            .map(|(t, tri)| cut.tile_of(centroid(&corners(tri)), t as u64) as u32)
+            .collect();
+        let mut starts = vec![0usize; tiles + 1];
+        for &k in &tile_of {
+            starts[k as usize + 1] += 1;
+        }
+        for k in 0..tiles {
+            starts[k + 1] += starts[k];
+        }
+        let mut next = starts.clone();
+        let mut triangles = vec![0u32; count];
+        for (t, &k) in tile_of.iter().enumerate() {
+            triangles[next[k as usize]] = t as u32;
+            next[k as usize] += 1;
+        }
+        drop(tile_of);
+        let boxes = (starts.windows(2))
+            .map(|w| {
+                let part = &triangles[w[0]..w[1]];
+                bounds(
+                    part.iter()
+                        .map(|&t| centroid(&corners(&mesh.triangles[t as usize]))),
+                )
+            })
+            .collect();
         let border = border_flags(&mesh, &triangles, &starts);
         Tiling {
             mesh,
@@ -166,110 +192,225 @@ impl Tiling {
     }
 
     /// Tile `k` as a mesh: its triangles in input order, its border vertices first,
-    /// then the others, each group in input order.
+    /// then the others, each group in the order the triangles first use them
+    /// ([`TileBuilder`]).
     ///
     /// # Panics
     /// When `k >= self.len()`.
     pub fn tile(&self, k: usize) -> Tile {
         let part = &self.triangles[self.starts[k]..self.starts[k + 1]];
-        let mut used: Vec<u32> = part
-            .iter()
-            .flat_map(|&t| self.mesh.triangles[t as usize])
-            .collect();
-        used.sort_unstable();
-        used.dedup();
-        // local[i]: the tile's number for `used[i]`; border vertices numbered first.
-        let mut local = vec![0u32; used.len()];
-        let mut positions = Vec::with_capacity(used.len());
-        for border in [true, false] {
-            for (i, &v) in used.iter().enumerate() {
-                if self.border[v as usize] == border {
-                    local[i] = positions.len() as u32;
-                    positions.push(self.mesh.positions[v as usize]);
+        let mut builder = TileBuilder::default();
+        for &t in part {
+            let tri = self.mesh.triangles[t as usize];
+            builder.push(tri.map(|v| {
+                let p = self.mesh.positions[v as usize];
+                (p, self.border[v as usize])
+            }));
+        }
+        builder.finish()
+    }
+}
+
+/// How many centroids a [`Sample`] holds at most (about 32 MiB): up to this many
+/// triangles, the cut is made from every centroid.
+pub const SAMPLE_CAP: usize = 1 << 20;
+
+/// A triangle's centroid: each coordinate `(a + b + c) / 3` of its corners'.
+#[inline]
+pub(crate) fn centroid(corners: &[[f64; 3]; 3]) -> [f64; 3] {
+    let [a, b, c] = corners;
+    std::array::from_fn(|k| (a[k] + b[k] + c[k]) / 3.0)
+}
+
+/// The centroids a [`Cut`] is made from: of the triangles offered (numbered in input
+/// order), every `stride`-th, the stride starting at 1 and doubling whenever more than
+/// [`SAMPLE_CAP`] would be held (those off the new stride are let go). Which ones are
+/// kept depends only on the count, so a mesh and the same triangles streamed give the
+/// same sample.
+#[derive(Clone, Debug)]
+pub(crate) struct Sample {
+    stride: u64,
+    points: Vec<([f64; 3], u64)>,
+}
+
+impl Sample {
+    pub(crate) fn new() -> Self {
+        Sample {
+            stride: 1,
+            points: Vec::new(),
+        }
+    }
+
+    /// Offers triangle `number`'s centroid (numbers offered in increasing order).
+    #[inline]
+    pub(crate) fn offer(&mut self, number: u64, centroid: [f64; 3]) {
+        if number % self.stride != 0 {
+            return;
+        }
+        self.points.push((centroid, number));
+        if self.points.len() > SAMPLE_CAP {
+            self.stride *= 2;
+            let stride = self.stride;
+            self.points.retain(|(_, n)| n % stride == 0);
+        }
+    }
+}
+
+/// A k-d cut of the triangles into tiles, made from a [`Sample`] of their centroids.
+/// A part (at first the whole sample) to be cut into `n > 1` tiles is split along the
+/// axis of the largest spread of its centroids (the first of equals), at the key
+/// (coordinate, triangle number) of rank `len · ⌊n/2⌋ / n`: the keys below it go to the
+/// first `⌊n/2⌋` tiles, the others to the rest. So a triangle's tile follows from its
+/// centroid and number alone ([`tile_of`](Self::tile_of)), and with every centroid in
+/// the sample, the tiles' counts are equal within one.
+#[derive(Clone, Debug)]
+pub(crate) struct Cut {
+    nodes: Vec<CutNode>,
+}
+
+#[derive(Clone, Copy, Debug)]
+enum CutNode {
+    /// Keys below `key` along `axis` go to node `left`, the others to `left + 1`'s
+    /// subtree at `right`.
+    Split {
+        axis: usize,
+        key: (f64, u64),
+        left: u32,
+        right: u32,
+    },
+    /// Everything here goes to this tile.
+    Tile(usize),
+}
+
+impl Cut {
+    /// The cut into `tiles` tiles (at least 1) made from `sample`.
+    pub(crate) fn new(sample: Sample, tiles: usize) -> Cut {
+        let mut points = sample.points;
+        let mut nodes = Vec::new();
+        Self::build(&mut points, 0, tiles.max(1), &mut nodes);
+        Cut { nodes }
+    }
+
+    fn build(
+        part: &mut [([f64; 3], u64)],
+        first: usize,
+        tiles: usize,
+        nodes: &mut Vec<CutNode>,
+    ) -> u32 {
+        let at = nodes.len() as u32;
+        if tiles <= 1 || part.len() <= 1 {
+            // The part's triangles go to its first tile; the others stay empty (with
+            // every centroid sampled, only when there are fewer triangles than tiles).
+            nodes.push(CutNode::Tile(first));
+            return at;
+        }
+        let (min, max) = bounds(part.iter().map(|p| p.0));
+        let axis = (0..3)
+            .max_by(|&a, &b| {
+                (max[a] - min[a])
+                    .total_cmp(&(max[b] - min[b]))
+                    .then(b.cmp(&a))
+            })
+            .unwrap_or(0);
+        let left_tiles = tiles / 2;
+        // Proportional, so that every tile ends up with its share (within one).
+        let cut = part.len() * left_tiles / tiles;
+        let by_key = |a: &([f64; 3], u64), b: &([f64; 3], u64)| {
+            a.0[axis].total_cmp(&b.0[axis]).then(a.1.cmp(&b.1))
+        };
+        part.select_nth_unstable_by(cut, by_key);
+        let key = (part[cut].0[axis], part[cut].1);
+        nodes.push(CutNode::Tile(first)); // replaced below
+        let (lo, hi) = part.split_at_mut(cut);
+        let left = Self::build(lo, first, left_tiles, nodes);
+        let right = Self::build(hi, first + left_tiles, tiles - left_tiles, nodes);
+        nodes[at as usize] = CutNode::Split {
+            axis,
+            key,
+            left,
+            right,
+        };
+        at
+    }
+
+    /// The tile of triangle `number`, whose centroid is `centroid`.
+    pub(crate) fn tile_of(&self, centroid: [f64; 3], number: u64) -> usize {
+        let mut at = 0;
+        loop {
+            match self.nodes.get(at) {
+                Some(&CutNode::Split {
+                    axis,
+                    key,
+                    left,
+                    right,
+                }) => {
+                    let below = centroid[axis].total_cmp(&key.0).then(number.cmp(&key.1));
+                    at = if below.is_lt() { left } else { right } as usize;
                 }
+                Some(&CutNode::Tile(k)) => return k,
+                None => return 0,
             }
         }
-        let border_vertices = used.iter().filter(|&&v| self.border[v as usize]).count();
-        let triangles = part
-            .iter()
-            .map(|&t| {
-                self.mesh.triangles[t as usize].map(|v| {
-                    // Every corner is in `used`, built from these very triangles.
-                    let i = used.binary_search(&v).unwrap_or(0);
-                    local[i]
-                })
-            })
+    }
+}
+
+/// Builds one tile from its triangles, given in input order as corners (position,
+/// whether it is a border vertex): vertices welded by bit-identical position (`-0.0`
+/// as `+0.0`, as the exact weld), the border ones numbered first, each group in the
+/// order the triangles first use it. The one way a tile is numbered, in memory
+/// ([`Tiling::tile`]) and from disk (`jobs::split`).
+#[derive(Debug, Default)]
+pub(crate) struct TileBuilder {
+    number: FxHashMap<[u64; 3], u32>,
+    positions: Vec<[f64; 3]>,
+    border: Vec<bool>,
+    triangles: Vec<[u32; 3]>,
+}
+
+impl TileBuilder {
+    /// Adds a triangle.
+    pub(crate) fn push(&mut self, corners: [([f64; 3], bool); 3]) {
+        let t = corners.map(|(p, border)| {
+            let fresh = self.positions.len() as u32;
+            let n = *self.number.entry(position_key(p)).or_insert(fresh);
+            if n == fresh {
+                self.positions.push(p);
+                self.border.push(border);
+            }
+            n
+        });
+        self.triangles.push(t);
+    }
+
+    /// The tile: border vertices first (see the type's docs).
+    pub(crate) fn finish(self) -> Tile {
+        let TileBuilder {
+            number,
+            positions,
+            border,
+            triangles,
+        } = self;
+        drop(number);
+        let border_vertices = border.iter().filter(|&&b| b).count();
+        let mut new_of = vec![0u32; positions.len()];
+        let (mut b, mut o) = (0u32, border_vertices as u32);
+        for (n, &is_border) in new_of.iter_mut().zip(&border) {
+            let slot = if is_border { &mut b } else { &mut o };
+            *n = *slot;
+            *slot += 1;
+        }
+        let mut ordered = vec![[0.0; 3]; positions.len()];
+        for (p, &n) in positions.iter().zip(&new_of) {
+            ordered[n as usize] = *p;
+        }
+        let triangles = triangles
+            .into_iter()
+            .map(|t| t.map(|v| new_of[v as usize]))
             .collect();
         Tile {
-            mesh: IndexedMesh::new(positions, triangles),
+            mesh: IndexedMesh::new(ordered, triangles),
             border_vertices,
         }
-    }
-}
-
-/// Cuts `part` (triangle numbers, at `offset` in the whole list) into `tiles` tiles,
-/// pushing each tile's end (an index into the whole list) to `ends`, left to right.
-fn bisect(
-    part: &mut [u32],
-    offset: usize,
-    tiles: usize,
-    centroids: Centroids<'_>,
-    ends: &mut Vec<usize>,
-) {
-    if tiles <= 1 || part.len() <= 1 {
-        // With at least as many triangles as tiles on entry (`new` clamps the count),
-        // the proportional cut below keeps that true on both sides, so `tiles` is 1
-        // here; the loop only keeps one end per tile should it not be.
-        for _ in 0..tiles.max(1) {
-            ends.push(offset + part.len());
-        }
-        return;
-    }
-    let (min, max) = bounds(part.iter().map(|&t| centroids.of(t)));
-    // The axis of the largest spread; the first of equals, so the choice is one.
-    let axis = (0..3)
-        .max_by(|&a, &b| {
-            (max[a] - min[a])
-                .total_cmp(&(max[b] - min[b]))
-                .then(b.cmp(&a))
-        })
-        .unwrap_or(0);
-    let left_tiles = tiles / 2;
-    // Proportional, so that every tile ends up with its share (within one).
-    let cut = part.len() * left_tiles / tiles;
-    // Unique keys (coordinate, then triangle number): the two sides are the same
-    // sets whatever the selection algorithm does.
-    let key = |&a: &u32, &b: &u32| -> Ordering {
-        centroids
-            .coordinate(a, axis)
-            .total_cmp(&centroids.coordinate(b, axis))
-            .then(a.cmp(&b))
-    };
-    if cut > 0 && cut < part.len() {
-        part.select_nth_unstable_by(cut, key);
-    }
-    let (left, right) = part.split_at_mut(cut);
-    bisect(left, offset, left_tiles, centroids, ends);
-    bisect(right, offset + cut, tiles - left_tiles, centroids, ends);
-}
-
-/// The triangles' centroids, computed when asked (a table of them would be 24 bytes a
-/// triangle, twice the triangles themselves). Each coordinate is `(a + b + c) / 3` of
-/// the corners', the same bits however it is asked.
-#[derive(Clone, Copy)]
-struct Centroids<'a>(&'a IndexedMesh);
-
-impl Centroids<'_> {
-    /// Coordinate `axis` of triangle `t`'s centroid.
-    #[inline]
-    fn coordinate(self, t: u32, axis: usize) -> f64 {
-        let [a, b, c] = self.0.triangles[t as usize].map(|i| self.0.positions[i as usize][axis]);
-        (a + b + c) / 3.0
-    }
-
-    /// Triangle `t`'s centroid.
-    fn of(self, t: u32) -> [f64; 3] {
-        std::array::from_fn(|axis| self.coordinate(t, axis))
     }
 }
 
@@ -562,6 +703,34 @@ mod tests {
             }
         }
         IndexedMesh::new(positions, triangles)
+    }
+
+    /// Past the cap, every other centroid goes, then every other of those...: which
+    /// ones are kept follows from the count alone.
+    #[test]
+    fn the_sample_halves_past_its_cap() {
+        let mut sample = Sample::new();
+        let n = SAMPLE_CAP as u64 * 2;
+        for i in 0..n {
+            sample.offer(i, [i as f64, 0.0, 0.0]);
+        }
+        assert_eq!(sample.stride, 2);
+        assert_eq!(sample.points.len() as u64, n.div_ceil(2));
+        assert!(sample
+            .points
+            .iter()
+            .all(|&(p, i)| i % 2 == 0 && p[0] == i as f64));
+        sample.offer(n, [n as f64, 0.0, 0.0]);
+        assert_eq!(sample.stride, 4);
+        assert!(sample.points.len() <= SAMPLE_CAP);
+        // Cut from it, the tiles of the numbers left out follow their neighbours'.
+        let cut = Cut::new(sample, 4);
+        let tiles: Vec<usize> = (0..n)
+            .step_by(n as usize / 16)
+            .map(|i| cut.tile_of([i as f64, 0.0, 0.0], i))
+            .collect();
+        assert!(tiles.windows(2).all(|w| w[0] <= w[1]), "{tiles:?}");
+        assert_eq!((tiles[0], tiles[tiles.len() - 1]), (0, 3));
     }
 
     #[test]
