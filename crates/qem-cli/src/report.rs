@@ -147,11 +147,11 @@ pub struct DroppedJson {
 
 impl AttributesJson {
     /// What became of the input's attributes (`input`, their names as
-    /// [`AttributesJson::names`] gives them) in the simplified mesh's `output`, written
+    /// [`Attributes::names`] gives them) in the simplified mesh's `output`, written
     /// in `format`; `lost` is why one the simplification did not keep is missing (only
     /// vertex clustering and tiles keep positions alone).
     pub fn new(input: Vec<String>, output: &Attributes, format: Format, lost: &str) -> Self {
-        let kept = Self::names(output);
+        let kept = output.names();
         let not_written = unwritable(output, format);
         let mut json = AttributesJson::default();
         for what in input {
@@ -170,22 +170,6 @@ impl AttributesJson {
             }
         }
         json
-    }
-
-    /// The names of what `a` holds, as the report gives them: its channels, then
-    /// `materials`, `groups` and `material libraries` when it has them.
-    pub fn names(a: &Attributes) -> Vec<String> {
-        let mut names: Vec<String> = a.channels.iter().map(|c| c.name.clone()).collect();
-        for (what, there) in [
-            ("materials", !a.materials.is_empty()),
-            ("groups", !a.groups.is_empty()),
-            ("material libraries", !a.material_libraries.is_empty()),
-        ] {
-            if there {
-                names.push(what.to_string());
-            }
-        }
-        names
     }
 
     /// `carried: uv, normal; dropped: colour (STL holds positions only)`, or `None`

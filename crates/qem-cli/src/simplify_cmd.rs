@@ -15,8 +15,8 @@ use qem_mesh::simplify::{
     simplify_levels_owned, simplify_owned, Observer, Simplified, SimplifyError, SimplifyOptions,
     StopReason, Target,
 };
-use qem_mesh::tiles::budget::{simplify_within, BudgetError};
-use qem_mesh::tiles::jobs::{SplitInput, TilesError};
+use qem_mesh::tiles::budget::{simplify_file_within, BudgetError};
+use qem_mesh::tiles::jobs::TilesError;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -155,6 +155,17 @@ fn run_single(args: &SimplifyArgs) -> Result<(), Failure> {
     Ok(())
 }
 
+/// What the report says of the input as read.
+struct InputRead {
+    /// Its attributes' names.
+    attributes: Vec<String>,
+    /// Its triangles and vertices.
+    counts: (usize, usize),
+    notes: ReadNotes,
+    /// The time reading it took.
+    load: Duration,
+}
+
 /// The directory a file is in (`.` for a bare name).
 fn directory_of(path: &Path) -> PathBuf {
     match path.parent() {
@@ -175,29 +186,43 @@ pub fn simplify_file(
     create_dirs: bool,
     budget: Option<&MemoryBudget>,
 ) -> Result<SimplifyJson, Failure> {
-    let (mesh, notes, load) = load(input)?;
-    let input_attributes = AttributesJson::names(&mesh.attributes);
-    let counts_in = (mesh.triangle_count(), mesh.vertex_count());
     let clock = Instant::now();
-    let (result, budget_json) = match budget {
-        // Handed over: the engine drops it once cleaned (see `simplify_owned`).
-        None => (
-            simplify_owned(mesh, options, observer).map_err(|e| simplify_failure(input, e))?,
-            None,
-        ),
-        Some(budget) => {
-            let split = SplitInput {
-                name: file_name(input),
-                size_bytes: std::fs::metadata(input).map_or(0, |m| m.len()),
-                mesh,
+    let (result, budget_json, read) = match budget {
+        None => {
+            let (mesh, notes, load) = load(input)?;
+            let read = InputRead {
+                attributes: mesh.attributes.names(),
+                counts: (mesh.triangle_count(), mesh.vertex_count()),
+                notes,
+                load,
             };
-            let run = simplify_within(split, options, budget.bytes, &budget.scratch, observer)
+            // Handed over: the engine drops it once cleaned (see `simplify_owned`).
+            let result =
+                simplify_owned(mesh, options, observer).map_err(|e| simplify_failure(input, e))?;
+            (result, None, read)
+        }
+        Some(budget) => {
+            // Read by the budgeted run itself, so that a file too large to fit is
+            // streamed into tiles rather than held.
+            let run = simplify_file_within(input, options, budget.bytes, &budget.scratch, observer)
                 .map_err(|e| budget_failure(input, e))?;
-            let json = MemoryBudgetJson::new(&run);
-            (run.result, Some(json))
+            let json = MemoryBudgetJson::new(&run.run);
+            let read = InputRead {
+                attributes: run.attributes,
+                counts: (run.triangles_in, run.vertices_in),
+                notes: run.notes,
+                load: run.load,
+            };
+            (run.run.result, Some(json), read)
         }
     };
-    let simplify_time = clock.elapsed();
+    let InputRead {
+        attributes: input_attributes,
+        counts: counts_in,
+        notes,
+        load,
+    } = read;
+    let simplify_time = clock.elapsed().saturating_sub(load);
     if result.report.stop_reason == StopReason::Cancelled || interrupted() {
         return Err(Failure::Interrupted);
     }
@@ -263,7 +288,7 @@ fn material_files_of(input: &Path, output: &Path, result: &Simplified) -> Materi
 /// Why an attribute the simplification did not keep is missing, without tiles.
 const CLUSTERING_KEEPS_POSITIONS: &str = "vertex clustering keeps positions only";
 
-/// What became of the input's attributes (`input`, as [`AttributesJson::names`] gives
+/// What became of the input's attributes (`input`, as [`Attributes::names`](qem_mesh::attributes::Attributes::names) gives
 /// them) in `result`, written to `output`; `lost` is why one the simplification did
 /// not keep is missing.
 fn attributes_of(
@@ -331,7 +356,7 @@ fn run_levels(args: &SimplifyArgs) -> Result<(), Failure> {
     let bar = simplify_bar(bars_wanted(args.quiet), &file_name(&args.input));
     let result = (|| {
         let (mesh, notes, load) = load(&args.input)?;
-        let input_attributes = AttributesJson::names(&mesh.attributes);
+        let input_attributes = mesh.attributes.names();
         let targets: Vec<Target> = args.lods.iter().map(|&r| Target::Ratio(r)).collect();
         let clock = Instant::now();
         let levels = simplify_levels_owned(

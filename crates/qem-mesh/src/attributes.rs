@@ -200,6 +200,30 @@ impl Attributes {
             && self.material_libraries.is_empty()
     }
 
+    /// The names of what the mesh carries besides positions: its channels' names,
+    /// then `materials`, `groups` and `material libraries` when it has them (as
+    /// reports list them).
+    ///
+    /// ```
+    /// use qem_mesh::attributes::{Attributes, Channel, ChannelKind};
+    /// let mut a = Attributes::default();
+    /// a.channels.push(Channel::new(ChannelKind::TexCoord, vec![0.0, 0.0], vec![[0; 3]]));
+    /// assert_eq!(a.names(), vec!["uv".to_string()]);
+    /// ```
+    pub fn names(&self) -> Vec<String> {
+        let mut names: Vec<String> = self.channels.iter().map(|c| c.name.clone()).collect();
+        for (what, there) in [
+            ("materials", !self.materials.is_empty()),
+            ("groups", !self.groups.is_empty()),
+            ("material libraries", !self.material_libraries.is_empty()),
+        ] {
+            if there {
+                names.push(what.to_string());
+            }
+        }
+        names
+    }
+
     /// The first channel of `kind`, if any.
     pub fn channel(&self, kind: ChannelKind) -> Option<&Channel> {
         self.channels.iter().find(|c| c.kind == kind)

@@ -413,7 +413,7 @@ fn stream_plain(
         vertices,
         triangles: triangle_count,
         notes,
-        attributes_dropped: !mesh.attributes.is_empty(),
+        attributes: mesh.attributes.names(),
     })
 }
 

@@ -46,9 +46,10 @@ pub struct Streamed {
     pub triangles: usize,
     /// What the reader passed over, as for an ordinary read.
     pub notes: ReadNotes,
-    /// Whether the file had attributes (texture coordinates, normals, colours,
-    /// materials, groups, channels), which a streaming read does not hand on.
-    pub attributes_dropped: bool,
+    /// The names of the attributes the file had (as
+    /// [`Attributes::names`](crate::attributes::Attributes::names) gives them), which a
+    /// streaming read does not hand on.
+    pub attributes: Vec<String>,
 }
 
 /// The triangles a reader makes: kept in a list (an ordinary read) or handed to a sink

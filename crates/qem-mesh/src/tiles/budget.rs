@@ -42,24 +42,28 @@
 //! distance of 0.384% and a mean of 0.0265% of the diagonal, in-core 0.393% and
 //! 0.0274%; tiles straight to 4% gave 9.8% and 0.41% (BENCHMARKS.md, "Tiles").
 //!
-//! What holds memory at each step, besides the program: the input mesh and the
-//! split's sample while its triangles go to disk, then one tile of the split (checked
-//! against the budget before the split); one
+//! What holds memory at each step, besides the program: the input's vertices while
+//! [`simplify_file_within`] streams a file's triangles to disk (or, given a mesh,
+//! [`simplify_within`]'s input mesh), and the split's sample; then one tile of the
+//! split (checked against the budget before a mesh in memory is split); one
 //! tile's simplification; the merged mesh and its vertices' quadrics (80 bytes a
 //! vertex, which become the finish's own quadrics); the in-core finish. The input's
 //! attributes are not carried by tiles: a run that tiles drops them (the caller is
 //! told, in [`BudgetRun::rounds`]).
 
 use super::jobs::{
-    merge_carrying, split_mesh, SplitInput, TileCount, TileDir, TileOptions, TilesError,
+    merge_carrying, split_mesh, split_spilled, Source, SplitInput, TileCount, TileDir, TileOptions,
+    TilesError,
 };
-use crate::io::IoError;
+use super::split::{Spill, Spilled};
+use crate::io::{read_path, stream_path, IoError, ReadNotes};
 use crate::simplify::{
     simplify_carrying, simplify_owned, CarriedQuadrics, Method, Observer, Simplified,
     SimplifyError, SimplifyOptions, Target,
 };
 use crate::IndexedMesh;
 use std::path::Path;
+use std::time::{Duration, Instant};
 
 /// Bytes a triangle of a whole in-core `qem simplify` process with the contraction
 /// engine, the most measured on a large closed mesh, rounded up: 255 (the defaults),
@@ -219,105 +223,219 @@ pub fn simplify_within(
     scratch: &Path,
     observer: &mut dyn Observer,
 ) -> Result<BudgetRun, BudgetError> {
-    let mut mesh = input.mesh;
-    let triangles_in = mesh.triangle_count();
+    run(First::Mesh(input), options, budget, scratch, observer)
+}
+
+/// What a budgeted run starts from: a mesh in memory, or a file's triangles already
+/// streamed to disk (too many to fit).
+enum First {
+    Mesh(SplitInput),
+    Spilled {
+        source: Source,
+        spilled: Spilled,
+        /// The temporary directory the spill is in.
+        work: tempfile::TempDir,
+    },
+}
+
+/// [`simplify_within`] for a file, which it reads itself so that a file too large
+/// to fit is never held: the file is streamed to disk as it is read (as `qem tiles
+/// split` streams it: the reader holds its vertices, 24 bytes each, not its
+/// triangles); when its triangles fit in core after all, the spill is let go and the
+/// file is read again, as [`read_path`] reads it, and simplified in core (so a file
+/// that fits is read twice). Otherwise its first round of tiles is cut from the spill.
+/// The same file, options and budget give what [`simplify_within`] gives for the mesh
+/// read from it.
+pub fn simplify_file_within(
+    input: &Path,
+    options: &SimplifyOptions,
+    budget: u64,
+    scratch: &Path,
+    observer: &mut dyn Observer,
+) -> Result<FileBudgetRun, BudgetError> {
+    let clock = Instant::now();
+    let room = room_for(budget, options);
+    let work = work_directory(scratch)?;
+    let mut spill = Spill::create(work.path())?;
+    let streamed = stream_path(input, &mut spill)?;
+    let spilled = spill.finish()?;
+    let source = Source {
+        name: input
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default(),
+        size_bytes: std::fs::metadata(input).map_or(0, |m| m.len()),
+        vertices: streamed.vertices,
+        attributes_dropped: !streamed.attributes.is_empty(),
+    };
+    let (triangles_in, vertices_in) = (streamed.triangles, streamed.vertices);
+    if triangles_in <= room {
+        drop(spilled);
+        drop(work);
+        let loaded = read_path(input)?;
+        let load = clock.elapsed();
+        let attributes = loaded.mesh.attributes.names();
+        let split = SplitInput {
+            name: source.name,
+            size_bytes: source.size_bytes,
+            mesh: loaded.mesh,
+        };
+        let run = run(First::Mesh(split), options, budget, scratch, observer)?;
+        return Ok(FileBudgetRun {
+            run,
+            triangles_in,
+            vertices_in,
+            notes: loaded.notes,
+            attributes,
+            load,
+        });
+    }
+    let load = clock.elapsed();
+    let first = First::Spilled {
+        source,
+        spilled,
+        work,
+    };
+    Ok(FileBudgetRun {
+        run: run(first, options, budget, scratch, observer)?,
+        triangles_in,
+        vertices_in,
+        notes: streamed.notes,
+        attributes: streamed.attributes,
+        load,
+    })
+}
+
+/// What [`simplify_file_within`] did, and what it read.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct FileBudgetRun {
+    /// The run.
+    pub run: BudgetRun,
+    /// The file's triangles, as read.
+    pub triangles_in: usize,
+    /// Its vertices, as read.
+    pub vertices_in: usize,
+    /// What the reader passed over.
+    pub notes: ReadNotes,
+    /// The names of the file's attributes ([`Attributes::names`](crate::attributes::Attributes::names)).
+    pub attributes: Vec<String>,
+    /// The time spent reading the file (streaming it, and reading it again when it
+    /// fitted).
+    pub load: Duration,
+}
+
+/// The triangles an in-core run with `options` can hold within `budget`.
+fn room_for(budget: u64, options: &SimplifyOptions) -> usize {
+    (budget.saturating_sub(FIXED_BYTES) / bytes_per_triangle(options)) as usize
+}
+
+/// A temporary directory for a run's files in `scratch`.
+fn work_directory(scratch: &Path) -> Result<tempfile::TempDir, IoError> {
+    tempfile::Builder::new()
+        .prefix(".qem-budget-")
+        .tempdir_in(scratch)
+        .map_err(|source| IoError::File {
+            path: scratch.to_path_buf(),
+            action: "create a temporary directory in",
+            source,
+        })
+}
+
+/// The run from `first` (see [`simplify_within`]).
+fn run(
+    first: First,
+    options: &SimplifyOptions,
+    budget: u64,
+    scratch: &Path,
+    observer: &mut dyn Observer,
+) -> Result<BudgetRun, BudgetError> {
+    let triangles_in = match &first {
+        First::Mesh(input) => input.mesh.triangle_count(),
+        First::Spilled { spilled, .. } => spilled.triangles as usize,
+    };
     let target = options.target.triangles_for(triangles_in);
-    let room = (budget.saturating_sub(FIXED_BYTES) / bytes_per_triangle(options)) as usize;
+    let room = room_for(budget, options);
     let finish_target = match options.target {
         Target::None => Target::None,
         _ => Target::Triangles(target),
     };
     let mut rounds: Vec<BudgetRound> = Vec::new();
     let mut carried: Option<CarriedQuadrics> = None;
-    if triangles_in > room {
-        if options.method == Method::Clustering {
-            return Err(BudgetError::TooSmall {
-                budget,
-                needed: in_core_bytes(triangles_in, options),
-                what: "vertex clustering, which runs in one piece",
-            });
-        }
-        if target > room {
-            return Err(BudgetError::TooSmall {
-                budget,
-                needed: in_core_bytes(target, options),
-                what: "the last step, which holds the output's triangles in one piece",
-            });
-        }
-        if room < MIN_ROOM {
-            return Err(BudgetError::TooSmall {
-                budget,
-                needed: in_core_bytes(MIN_ROOM, options),
-                what: "tiles of at least 10,000 triangles",
-            });
-        }
-        // Checked before any file is written: a tile job refuses the same options.
-        TileOptions::new(options.clone().with_target(Target::Ratio(0.5)))
-            .map_err(TilesError::from)?;
-        let work = tempfile::Builder::new()
-            .prefix(".qem-budget-")
-            .tempdir_in(scratch)
-            .map_err(|source| IoError::File {
-                path: scratch.to_path_buf(),
-                action: "create a temporary directory in",
-                source,
-            })?;
-        let mut name = input.name;
-        let mut size_bytes = input.size_bytes;
-        while mesh.triangle_count() > room {
-            if let Some(last) = rounds.last().filter(|_| rounds.len() == MAX_ROUNDS) {
-                return Err(BudgetError::Stuck {
-                    triangles_in: last.triangles_in,
-                    triangles_out: last.triangles_out,
-                });
-            }
-            let needed = split_bytes(&mesh, room);
-            if needed > budget {
+    let mut mesh = match first {
+        First::Mesh(input) if triangles_in <= room => input.mesh,
+        first => {
+            if options.method == Method::Clustering {
                 return Err(BudgetError::TooSmall {
                     budget,
-                    needed,
-                    what: "cutting the mesh into tiles",
+                    needed: in_core_bytes(triangles_in, options),
+                    what: "vertex clustering, which runs in one piece",
                 });
             }
-            let dir = work.path().join(format!("round-{}", rounds.len() + 1));
-            // The split cuts meshes only: an earlier round's quadrics are not needed
-            // again, and not held through this round.
-            drop(carried.take());
-            let (round, merged, quadrics) = tile_round(
-                SplitInput {
-                    name: std::mem::take(&mut name),
-                    size_bytes,
-                    mesh,
-                },
+            if target > room {
+                return Err(BudgetError::TooSmall {
+                    budget,
+                    needed: in_core_bytes(target, options),
+                    what: "the last step, which holds the output's triangles in one piece",
+                });
+            }
+            if room < MIN_ROOM {
+                return Err(BudgetError::TooSmall {
+                    budget,
+                    needed: in_core_bytes(MIN_ROOM, options),
+                    what: "tiles of at least 10,000 triangles",
+                });
+            }
+            // Checked before any file is written: a tile job refuses the same options.
+            TileOptions::new(options.clone().with_target(Target::Ratio(0.5)))
+                .map_err(TilesError::from)?;
+            let (first_round, work) = match first {
+                First::Mesh(input) => {
+                    let needed = split_bytes(&input.mesh, room);
+                    if needed > budget {
+                        return Err(BudgetError::TooSmall {
+                            budget,
+                            needed,
+                            what: "cutting the mesh into tiles",
+                        });
+                    }
+                    (FirstRound::Mesh(input), work_directory(scratch)?)
+                }
+                First::Spilled {
+                    source,
+                    spilled,
+                    work,
+                } => (FirstRound::Spilled(source, spilled), work),
+            };
+            let (mut mesh, quadrics) = tile_rounds(
+                first_round,
                 options,
                 room,
                 target,
-                &dir,
+                budget,
+                &work,
+                &mut rounds,
                 observer,
             )?;
-            if round.triangles_out >= round.triangles_in {
-                return Err(BudgetError::Stuck {
-                    triangles_in: round.triangles_in,
-                    triangles_out: round.triangles_out,
-                });
-            }
-            (mesh, carried) = (merged, Some(quadrics));
-            // What the next round's manifest names as its input: no file.
-            name = format!("the merged tiles of round {}", rounds.len() + 1);
-            size_bytes = 0;
-            // The round's files are not needed again: free the disk as we go.
-            let _ = std::fs::remove_dir_all(&dir);
-            rounds.push(round);
+            drop(work);
+            carried = Some(quadrics);
+            std::mem::take(&mut mesh)
         }
-        drop(work);
-    }
+    };
     let finish = options.clone().with_target(finish_target);
     let result = match carried {
         Some(carried) => {
             let origin = carried.origin;
-            simplify_carrying(mesh, &finish, Some(carried), origin, observer)?.0
+            simplify_carrying(
+                std::mem::take(&mut mesh),
+                &finish,
+                Some(carried),
+                origin,
+                observer,
+            )?
+            .0
         }
-        None => simplify_owned(mesh, &finish, observer)?,
+        None => simplify_owned(std::mem::take(&mut mesh), &finish, observer)?,
     };
     Ok(BudgetRun {
         result,
@@ -326,6 +444,73 @@ pub fn simplify_within(
         room,
         target_triangles: target,
     })
+}
+
+/// What a budgeted run's first round of tiles is cut from.
+enum FirstRound {
+    Mesh(SplitInput),
+    Spilled(Source, Spilled),
+}
+
+/// Rounds of tiles in `work` until the merged mesh fits in `room` triangles: the first
+/// cut from `first`, the later ones from the merged mesh of the round before. Returns
+/// the last merged mesh and its vertices' quadrics; each round goes to `rounds`.
+#[allow(clippy::too_many_arguments)]
+fn tile_rounds(
+    first: FirstRound,
+    options: &SimplifyOptions,
+    room: usize,
+    target: usize,
+    budget: u64,
+    work: &tempfile::TempDir,
+    rounds: &mut Vec<BudgetRound>,
+    observer: &mut dyn Observer,
+) -> Result<(IndexedMesh, CarriedQuadrics), BudgetError> {
+    let mut input = first;
+    loop {
+        let dir = work.path().join(format!("round-{}", rounds.len() + 1));
+        let (round, mesh, quadrics) = tile_round(input, options, room, target, &dir, observer)?;
+        if round.triangles_out >= round.triangles_in {
+            return Err(BudgetError::Stuck {
+                triangles_in: round.triangles_in,
+                triangles_out: round.triangles_out,
+            });
+        }
+        // The round's files are not needed again: free the disk as we go.
+        let _ = std::fs::remove_dir_all(&dir);
+        rounds.push(round);
+        if mesh.triangle_count() <= room {
+            return Ok((mesh, quadrics));
+        }
+        if rounds.len() == MAX_ROUNDS {
+            return Err(BudgetError::Stuck {
+                triangles_in: round_in(rounds),
+                triangles_out: mesh.triangle_count(),
+            });
+        }
+        let needed = split_bytes(&mesh, room);
+        if needed > budget {
+            return Err(BudgetError::TooSmall {
+                budget,
+                needed,
+                what: "cutting the mesh into tiles",
+            });
+        }
+        // The split cuts meshes only: this round's quadrics are not needed again, and
+        // not held through the next.
+        drop(quadrics);
+        input = FirstRound::Mesh(SplitInput {
+            // What the next round's manifest names as its input: no file.
+            name: format!("the merged tiles of round {}", rounds.len()),
+            size_bytes: 0,
+            mesh,
+        });
+    }
+}
+
+/// The triangles the last of `rounds` cut.
+fn round_in(rounds: &[BudgetRound]) -> usize {
+    rounds.last().map_or(0, |r| r.triangles_in)
 }
 
 /// About the bytes the split of `mesh` into tiles of at most `room` triangles holds:
@@ -353,20 +538,33 @@ fn attribute_bytes(mesh: &IndexedMesh) -> u64 {
 /// simplified to leave `max(target, room × MERGED_SHARE)` triangles in all, merged;
 /// the merged mesh comes with its vertices' quadrics.
 fn tile_round(
-    input: SplitInput,
+    input: FirstRound,
     options: &SimplifyOptions,
     room: usize,
     target: usize,
     dir: &Path,
     observer: &mut dyn Observer,
 ) -> Result<(BudgetRound, IndexedMesh, CarriedQuadrics), BudgetError> {
-    let triangles_in = input.mesh.triangle_count();
-    let attributes_dropped = !input.mesh.attributes.is_empty();
+    let (triangles_in, attributes_dropped) = match &input {
+        FirstRound::Mesh(input) => (
+            input.mesh.triangle_count(),
+            !input.mesh.attributes.is_empty(),
+        ),
+        FirstRound::Spilled(source, spilled) => {
+            (spilled.triangles as usize, source.attributes_dropped)
+        }
+    };
     let keep = target.max((room as f64 * MERGED_SHARE) as usize);
     let tile_ratio = keep as f64 / triangles_in as f64;
     let tile_options = TileOptions::new(options.clone().with_target(Target::Ratio(tile_ratio)))
         .map_err(TilesError::from)?;
-    split_mesh(input, dir, TileCount::MaxTriangles(room), observer)?;
+    let count = TileCount::MaxTriangles(room);
+    match input {
+        FirstRound::Mesh(input) => split_mesh(input, dir, count, observer)?,
+        FirstRound::Spilled(source, spilled) => {
+            split_spilled(source, spilled, dir, count, observer)?
+        }
+    };
     let tiles = TileDir::open(dir)?;
     for k in 0..tiles.len() {
         tiles.simplify_tile(k, &tile_options, observer)?;

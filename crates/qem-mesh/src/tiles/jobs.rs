@@ -722,7 +722,7 @@ pub fn split(
         name,
         size_bytes,
         vertices: streamed.vertices,
-        attributes_dropped: streamed.attributes_dropped,
+        attributes_dropped: !streamed.attributes.is_empty(),
     };
     write_tiles(
         source,
@@ -735,11 +735,24 @@ pub fn split(
 }
 
 /// What the manifest says of a split's input besides its triangles.
-struct Source {
-    name: String,
-    size_bytes: u64,
-    vertices: usize,
-    attributes_dropped: bool,
+pub(super) struct Source {
+    pub(super) name: String,
+    pub(super) size_bytes: u64,
+    pub(super) vertices: usize,
+    pub(super) attributes_dropped: bool,
+}
+
+/// [`split`] of an input whose triangles are on disk already (streamed by
+/// [`super::budget`] to learn whether it fits): the same files.
+pub(super) fn split_spilled(
+    source: Source,
+    spilled: Spilled,
+    dir: &Path,
+    count: TileCount,
+    observer: &mut dyn Observer,
+) -> Result<Manifest, TilesError> {
+    let manifest_path = clear_for_split(dir)?;
+    write_tiles(source, spilled, dir, &manifest_path, count, observer)
 }
 
 /// A mesh to [`split_mesh`], already in memory, with what the manifest says of the file
