@@ -2,7 +2,9 @@
 //! reader.
 
 use qem_mesh::attributes::ChannelKind;
-use qem_mesh::io::{read_bytes, write_to, Format};
+use qem_mesh::io::{
+    read_bytes, stream_bytes, write_to, Format, IoError, StreamBytesError, TriangleSink,
+};
 use qem_mesh::IndexedMesh;
 
 /// `read_obj`: see [`read_checked`].
@@ -37,6 +39,52 @@ pub fn read_gltf(data: &[u8]) {
     read_checked(data, format);
 }
 
+/// Every triangle a streaming read hands on, as its corners' bits.
+#[derive(Default)]
+struct Collect(Vec<[[u64; 3]; 3]>);
+
+impl TriangleSink for Collect {
+    fn triangle(&mut self, corners: [[f64; 3]; 3]) -> Result<(), IoError> {
+        self.0.push(corners.map(|p| p.map(f64::to_bits)));
+        Ok(())
+    }
+}
+
+/// A streaming read of `data` ([`stream_bytes`]) fails exactly when [`read_bytes`]
+/// fails, with the same message, and otherwise hands on the mesh's triangles (in its
+/// order but for triangles that waited for their vertices) and its counts.
+fn streamed_as_read(data: &[u8], format: Format) {
+    let mut sink = Collect::default();
+    let streamed = stream_bytes(data, format, &mut sink);
+    match (read_bytes(data, format), streamed) {
+        (Ok(loaded), Ok(streamed)) => {
+            let mesh = &loaded.mesh;
+            let mut expected: Vec<[[u64; 3]; 3]> = mesh
+                .triangles
+                .iter()
+                .map(|t| t.map(|v| mesh.positions[v as usize].map(f64::to_bits)))
+                .collect();
+            let mut got = sink.0;
+            if got != expected {
+                got.sort_unstable();
+                expected.sort_unstable();
+                assert!(got == expected, "streamed triangles differ");
+            }
+            assert_eq!(streamed.triangles, mesh.triangle_count());
+            assert_eq!(streamed.vertices, mesh.vertex_count());
+            assert_eq!(streamed.attributes, mesh.attributes.names());
+        }
+        (Err(read), Err(StreamBytesError::Read(stream))) => {
+            assert_eq!(stream.to_string(), read.to_string());
+        }
+        (read, streamed) => panic!(
+            "read {:?} but streamed {:?}",
+            read.map(|l| l.mesh.triangle_count()),
+            streamed.map(|s| s.triangles)
+        ),
+    }
+}
+
 /// Arbitrary bytes give a mesh that passes validation or an error whose message is one
 /// non-empty line; never a panic. (Memory: libFuzzer's `-rss_limit_mb` and
 /// `-malloc_limit_mb` turn an allocation blow-up into a crash, see FUZZING.md.)
@@ -55,6 +103,7 @@ pub fn read_gltf(data: &[u8]) {
 ///   faces by group and material: the same faces (corner positions rounded to f32,
 ///   channel values, material and group) as a multiset.
 pub fn read_checked(data: &[u8], format: Format) {
+    streamed_as_read(data, format);
     let loaded = match read_bytes(data, format) {
         Ok(loaded) => loaded,
         Err(e) => {
