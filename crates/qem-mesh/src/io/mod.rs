@@ -331,10 +331,18 @@ fn read_input(
     format: Format,
     external: Option<gltf::External<'_>>,
 ) -> Result<LoadedMesh, ReadError> {
-    let read = read_plain(input, format, external);
-    // A gzip error anywhere in the stream wins over what the reader found.
+    to_the_end(input, |input| read_plain(input, format, external))
+}
+
+/// Runs `read` on `input`, then reads a gzip stream to its end: a gzip error anywhere
+/// in the stream wins over what the reader found.
+fn to_the_end<T, E: From<ReadError>>(
+    input: &mut Input<'_>,
+    read: impl FnOnce(&mut Input<'_>) -> Result<T, E>,
+) -> Result<T, E> {
+    let result = read(input);
     input.finish()?;
-    read
+    result
 }
 
 fn read_plain(
@@ -379,10 +387,7 @@ pub(crate) fn stream_input(
     external: Option<gltf::External<'_>>,
     sink: &mut dyn TriangleSink,
 ) -> Result<Streamed, StreamError> {
-    let read = stream_plain(input, format, external, sink);
-    // A gzip error anywhere in the stream wins over what the reader found.
-    input.finish()?;
-    read
+    to_the_end(input, |input| stream_plain(input, format, external, sink))
 }
 
 fn stream_plain(
@@ -467,6 +472,18 @@ fn parse(
 /// # Ok(()) }
 /// ```
 pub fn read_path(path: &Path) -> Result<LoadedMesh, IoError> {
+    from_file(path, |input, format, external| {
+        read_input(input, format, external).map_err(StreamError::Read)
+    })
+}
+
+/// Runs `read` on the file at `path`, in the format its name gives, with a `.gltf`'s
+/// external buffers read from beside it. Errors name the file; the system's error
+/// reading the file wins over a problem of its content.
+fn from_file<T>(
+    path: &Path,
+    read: impl FnOnce(&mut Input<'_>, Format, Option<gltf::External<'_>>) -> Result<T, StreamError>,
+) -> Result<T, IoError> {
     let read_err = |source| IoError::Read {
         path: path.to_path_buf(),
         source,
@@ -482,12 +499,16 @@ pub fn read_path(path: &Path) -> Result<LoadedMesh, IoError> {
         .map_err(file_err)?;
     let dir = directory_of(path);
     let open = |uri: &str, len: usize| read_buffer_file(&dir.join(uri), len);
-    let read = read_input(&mut input, format, Some(&open));
+    let read = read(&mut input, format, Some(&open));
     // The system's error reading the file, not a problem of its content.
     if let Some(source) = input.take_file_error() {
         return Err(file_err(source));
     }
-    read.map_err(read_err)
+    match read {
+        Ok(t) => Ok(t),
+        Err(StreamError::Read(e)) => Err(read_err(e)),
+        Err(StreamError::Sink(e)) => Err(e),
+    }
 }
 
 /// Reads a mesh file as [`read_path`] does, but hands each triangle to `sink` as it is
@@ -523,30 +544,9 @@ pub fn read_path(path: &Path) -> Result<LoadedMesh, IoError> {
 /// # Ok(()) }
 /// ```
 pub fn stream_path(path: &Path, sink: &mut dyn TriangleSink) -> Result<Streamed, IoError> {
-    let read_err = |source| IoError::Read {
-        path: path.to_path_buf(),
-        source,
-    };
-    let format = Format::from_path(path).map_err(read_err)?;
-    let file_err = |source| IoError::File {
-        path: path.to_path_buf(),
-        action: "read",
-        source,
-    };
-    let mut input = std::fs::File::open(path)
-        .and_then(Input::file)
-        .map_err(file_err)?;
-    let dir = directory_of(path);
-    let open = |uri: &str, len: usize| read_buffer_file(&dir.join(uri), len);
-    let read = stream_input(&mut input, format, Some(&open), sink);
-    if let Some(source) = input.take_file_error() {
-        return Err(file_err(source));
-    }
-    match read {
-        Ok(streamed) => Ok(streamed),
-        Err(StreamError::Read(e)) => Err(read_err(e)),
-        Err(StreamError::Sink(e)) => Err(e),
-    }
+    from_file(path, |input, format, external| {
+        stream_input(input, format, external, sink)
+    })
 }
 
 /// [`stream_path`] for data in memory in `format` (gzip data decompressed first), as

@@ -259,15 +259,7 @@ pub fn simplify_file_within(
     let mut spill = Spill::create(work.path())?;
     let streamed = stream_path(input, &mut spill)?;
     let spilled = spill.finish()?;
-    let source = Source {
-        name: input
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default(),
-        size_bytes: std::fs::metadata(input).map_or(0, |m| m.len()),
-        vertices: streamed.vertices,
-        attributes_dropped: !streamed.attributes.is_empty(),
-    };
+    let source = Source::of_file(input, &streamed)?;
     let (triangles_in, vertices_in) = (streamed.triangles, streamed.vertices);
     if triangles_in <= room {
         drop(spilled);
@@ -275,9 +267,10 @@ pub fn simplify_file_within(
         let loaded = read_path(input)?;
         let load = clock.elapsed();
         let attributes = loaded.mesh.attributes.names();
+        let (name, size_bytes) = source.file();
         let split = SplitInput {
-            name: source.name,
-            size_bytes: source.size_bytes,
+            name,
+            size_bytes,
             mesh: loaded.mesh,
         };
         let run = run(First::Mesh(split), options, budget, scratch, observer)?;

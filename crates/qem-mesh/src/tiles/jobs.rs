@@ -89,7 +89,7 @@ use super::{Tile, Welder};
 use crate::io::{
     directory_of, fingerprint, read_bytes, remove_stale_temporaries, remove_stale_temporaries_of,
     stream_path, write_atomically, write_json_atomically, write_path, write_to, Format, IoError,
-    OutputStamp, TriangleSink,
+    OutputStamp, Streamed, TriangleSink,
 };
 use crate::simplify::{
     simplify_carrying, CarriedQuadrics, Length, Method, Observer, SimplifyError, SimplifyOptions,
@@ -706,40 +706,46 @@ pub fn split(
     observer: &mut dyn Observer,
 ) -> Result<Manifest, TilesError> {
     let manifest_path = clear_for_split(dir)?;
-    let size_bytes = std::fs::metadata(input)
-        .map_err(|e| os_error(input, "read", e))?
-        .len();
     let mut spill = Spill::create(dir)?;
     let streamed = stream_path(input, &mut spill)?;
     if observer.should_stop() {
         return Err(TilesError::Cancelled);
     }
-    let name = input
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let source = Source {
-        name,
-        size_bytes,
-        vertices: streamed.vertices,
-        attributes_dropped: !streamed.attributes.is_empty(),
-    };
-    write_tiles(
-        source,
-        spill.finish()?,
-        dir,
-        &manifest_path,
-        count,
-        observer,
-    )
+    let source = Source::of_file(input, &streamed)?;
+    let spilled = spill.finish()?;
+    write_tiles(source, spilled, dir, &manifest_path, count, observer)
 }
 
 /// What the manifest says of a split's input besides its triangles.
 pub(super) struct Source {
-    pub(super) name: String,
-    pub(super) size_bytes: u64,
-    pub(super) vertices: usize,
+    name: String,
+    size_bytes: u64,
+    vertices: usize,
     pub(super) attributes_dropped: bool,
+}
+
+impl Source {
+    /// The account of file `input`, as `streamed` read it.
+    pub(super) fn of_file(input: &Path, streamed: &Streamed) -> Result<Source, TilesError> {
+        let size_bytes = std::fs::metadata(input)
+            .map_err(|e| os_error(input, "read", e))?
+            .len();
+        let name = input
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        Ok(Source {
+            name,
+            size_bytes,
+            vertices: streamed.vertices,
+            attributes_dropped: !streamed.attributes.is_empty(),
+        })
+    }
+
+    /// The name and size, for a [`SplitInput`] of the same file read whole.
+    pub(super) fn file(&self) -> (String, u64) {
+        (self.name.clone(), self.size_bytes)
+    }
 }
 
 /// [`split`] of an input whose triangles are on disk already (streamed by
@@ -799,14 +805,8 @@ pub fn split_mesh(
         attributes_dropped: !mesh.attributes.is_empty(),
     };
     drop(mesh);
-    write_tiles(
-        source,
-        spill.finish()?,
-        dir,
-        &manifest_path,
-        count,
-        observer,
-    )
+    let spilled = spill.finish()?;
+    write_tiles(source, spilled, dir, &manifest_path, count, observer)
 }
 
 /// Creates `dir` if missing and removes its old manifest (and stale temporaries)
