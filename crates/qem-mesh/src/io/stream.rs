@@ -57,8 +57,6 @@ pub struct Streamed {
 pub(crate) struct Triangles<'s> {
     kept: Vec<[u32; 3]>,
     stream: Option<Stream<'s>>,
-    /// Triangles made so far.
-    len: usize,
 }
 
 /// The streaming side of [`Triangles`].
@@ -71,6 +69,8 @@ struct Stream<'s> {
     /// Vertices already forgotten by the reader ([`Triangles::forget`]): the
     /// positions it passes start at this vertex number.
     forgotten: usize,
+    /// Triangles made so far.
+    made: usize,
 }
 
 impl<'s> Triangles<'s> {
@@ -79,7 +79,6 @@ impl<'s> Triangles<'s> {
         Triangles {
             kept: Vec::new(),
             stream: None,
-            len: 0,
         }
     }
 
@@ -92,8 +91,8 @@ impl<'s> Triangles<'s> {
                 waiting: Vec::new(),
                 failed: None,
                 forgotten: 0,
+                made: 0,
             }),
-            len: 0,
         }
     }
 
@@ -105,7 +104,10 @@ impl<'s> Triangles<'s> {
     /// Triangles made so far.
     #[inline]
     pub(crate) fn len(&self) -> usize {
-        self.len
+        match &self.stream {
+            None => self.kept.len(),
+            Some(stream) => stream.made,
+        }
     }
 
     /// Reserves room for `n` more kept triangles (nothing when streaming).
@@ -120,12 +122,12 @@ impl<'s> Triangles<'s> {
     /// `positions` yet.
     #[inline]
     pub(crate) fn push(&mut self, t: [u32; 3], positions: &[[f64; 3]]) {
-        let number = self.len as u32;
-        self.len += 1;
         let Some(stream) = &mut self.stream else {
             self.kept.push(t);
             return;
         };
+        let number = stream.made as u32;
+        stream.made += 1;
         if stream.failed.is_some() {
             return;
         }
@@ -204,7 +206,7 @@ impl<'s> Triangles<'s> {
             return Ok(positions.len());
         };
         let vertex_count = stream.forgotten + positions.len();
-        for (what, count) in [("vertices", vertex_count), ("triangles", self.len)] {
+        for (what, count) in [("vertices", vertex_count), ("triangles", stream.made)] {
             if count > MAX_ELEMENTS {
                 return Err(StreamEnd::Input(InputError::TooLarge {
                     what,
@@ -213,7 +215,7 @@ impl<'s> Triangles<'s> {
                 }));
             }
         }
-        if self.len == 0 {
+        if stream.made == 0 {
             return Err(StreamEnd::Input(InputError::NoTriangles));
         }
         if let Some(vertex) = positions

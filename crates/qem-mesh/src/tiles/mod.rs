@@ -8,12 +8,12 @@
 //!
 //! - [`Tiling::new`] welds the vertices with bit-identical positions (so an STL soup,
 //!   whose facets share no vertex, has its border found by position), and cuts the
-//!   triangles into tiles by a k-d bisection of their centroids ([`Cut`]): the set (or
+//!   triangles into tiles by a k-d bisection of their centroids (`Cut`): the set (or
 //!   part of it) whose centroids spread furthest along an axis is cut at the median
 //!   along that axis, so tiles get equal triangle counts wherever the surface lies in
 //!   its bounding box. A regular grid over the box would leave most cells of a surface
 //!   empty and the others uneven. The medians are those of a sample of the centroids
-//!   ([`Sample`]): every centroid up to [`SAMPLE_CAP`] triangles (equal counts within
+//!   (`Sample`): every centroid up to [`SAMPLE_CAP`] triangles (equal counts within
 //!   one), beyond that every `2^k`-th, so that the split of a file streamed from disk
 //!   (`jobs::split`) needs no list of every triangle and cuts exactly as this does.
 //! - [`Tiling::tile`] gives one tile as its own mesh, its **border vertices first**: a
@@ -193,7 +193,7 @@ impl Tiling {
 
     /// Tile `k` as a mesh: its triangles in input order, its border vertices first,
     /// then the others, each group in the order the triangles first use them
-    /// ([`TileBuilder`]).
+    /// (`TileBuilder`).
     ///
     /// # Panics
     /// When `k >= self.len()`.
@@ -211,7 +211,7 @@ impl Tiling {
     }
 }
 
-/// How many centroids a [`Sample`] holds at most (about 32 MiB): up to this many
+/// How many centroids the cut's sample holds at most (about 32 MiB): up to this many
 /// triangles, the cut is made from every centroid.
 pub const SAMPLE_CAP: usize = 1 << 20;
 
