@@ -29,6 +29,12 @@
 //! and STL (before the text formats streamed, their whole file was read first and its
 //! read error won); gzip data is always read to its end.
 //!
+//! **Triangles as they are read.** [`stream_path`] (and [`stream_bytes`]) read as
+//! [`read_path`] does but hand each triangle to a [`TriangleSink`] instead of keeping
+//! a list: PLY, OFF and STL without holding their triangles (see `io::stream`); OBJ
+//! and glTF are read whole first, for now. `qem tiles split` and `--memory-budget`
+//! cut files into tiles this way.
+//!
 //! Polygons are fan-triangulated from their first corner. Vertices are never welded
 //! or removed by the PLY, STL and OFF readers (an STL facet gives three new vertices);
 //! see [`obj`] for what the OBJ reader does to vertex order (numbered per `o`/`g`
@@ -387,7 +393,14 @@ pub(crate) fn stream_input(
     external: Option<gltf::External<'_>>,
     sink: &mut dyn TriangleSink,
 ) -> Result<Streamed, StreamError> {
-    to_the_end(input, |input| stream_plain(input, format, external, sink))
+    let read = stream_plain(input, format, external, sink);
+    // The sink's error (the disk full, say) is the caller's to hear, whatever the
+    // rest of the data holds; otherwise a gzip error wins, as for an ordinary read.
+    if matches!(read, Err(StreamError::Sink(_))) {
+        return read;
+    }
+    input.finish()?;
+    read
 }
 
 fn stream_plain(
@@ -397,7 +410,16 @@ fn stream_plain(
     sink: &mut dyn TriangleSink,
 ) -> Result<Streamed, StreamError> {
     let mut triangles = Triangles::streamed(sink);
-    let (mesh, notes) = parse(input, format, external, &mut triangles)?;
+    let (mesh, notes) = match parse(input, format, external, &mut triangles) {
+        Ok(parsed) => parsed,
+        // A reader that stopped for the sink's error gives that error.
+        Err(e) => {
+            return Err(match triangles.take_failure() {
+                Some(sink) => StreamError::Sink(sink),
+                None => StreamError::Read(e),
+            })
+        }
+    };
     if !mesh.triangles.is_empty() {
         // OBJ and glTF are read whole (their readers do not hand triangles on yet):
         // checked as an ordinary read is, then handed on.

@@ -252,6 +252,9 @@ pub(crate) fn read(
     // Per triangle, its face colour's index (filled from the first coloured face on).
     let mut triangle_colours: Vec<u32> = Vec::new();
     for f in 0..nf {
+        if triangles.has_failed() {
+            return Err(Triangles::stopped());
+        }
         let Some((no, l)) = next_content(&mut lines, &mut solid)? else {
             return Err(ReadError::truncated(
                 at(last_line),

@@ -668,7 +668,12 @@ impl Builder<'_, '_> {
     /// Starts a record of `side`'s element: a zero value in each of its channels, for
     /// [`Builder::store`] to fill.
     fn start_record(&mut self, side: Side) {
+        // A streaming read checks every value but keeps only the record being read.
+        let streamed = self.triangles.is_streamed();
         for v in self.values(side) {
+            if streamed {
+                v.data.clear();
+            }
             v.data.extend(std::iter::repeat_n(0.0, v.dimension));
         }
     }
@@ -915,6 +920,9 @@ fn read_ascii_element(
     }
     let what = plural(el.name);
     for r in 0..el.count {
+        if b.triangles.has_failed() {
+            return Err(Triangles::stopped());
+        }
         b.start_record(side);
         let mut p = [0.0; 3];
         for (&(name, prop), &role) in el.props.iter().zip(roles) {
@@ -1165,11 +1173,16 @@ fn read_fixed(
     if roles.iter().any(|r| matches!(r, Role::Coord(_))) {
         b.positions.reserve(room);
     }
-    for v in b.values(side) {
-        v.data.reserve(room * v.dimension);
+    if !b.triangles.is_streamed() {
+        for v in b.values(side) {
+            v.data.reserve(room * v.dimension);
+        }
     }
     let mut r = 0;
     while r < el.count {
+        if b.triangles.has_failed() {
+            return Err(Triangles::stopped());
+        }
         input.fill(stride)?;
         let window = input.window();
         let n = (window.len() / stride).min(el.count - r);
@@ -1215,6 +1228,9 @@ fn read_variable(
     }
     let mut r = 0;
     while r < el.count {
+        if b.triangles.has_failed() {
+            return Err(Triangles::stopped());
+        }
         let window = input.window();
         let (mut n, mut len) = whole_records(window, &el.props, big, el.count - r);
         if n == 0 {

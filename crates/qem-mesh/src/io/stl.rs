@@ -164,6 +164,9 @@ fn read_binary(
     let mut bad = None;
     let mut t = 0;
     while t < count {
+        if triangles.has_failed() {
+            return Err(Triangles::stopped());
+        }
         input.fill(RECORD)?;
         let window = input.window();
         let k = (window.len() / RECORD).min(count - t);
@@ -374,6 +377,9 @@ fn read_ascii(
                 triangles.push(t, &positions);
             }
             triangles.forget(&mut positions);
+            if triangles.has_failed() {
+                return Err(Triangles::stopped());
+            }
             facets += 1;
         } else if word == Word::Other && skipped_line != line {
             // An exporter's extension or junk: it has no say in the geometry.

@@ -4,18 +4,16 @@
 //!
 //! The readers are the ones [`read_path`](super::read_path) uses, in a mode where the
 //! triangles they make go to the sink instead of into a list ([`Triangles`]). What a
-//! streaming read still holds: PLY, OFF and OBJ keep their vertices (24 bytes each, the
-//! faces name them by number) and, for OBJ, the per-element bookkeeping its reader
-//! keeps anyway (`io::obj`'s docs); STL keeps only the facet being read; glTF is read
-//! whole, as always, and its triangles are handed on afterwards. Per-vertex attribute
-//! values are read (and checked) as by an ordinary read, then dropped; per-corner and
-//! per-face ones are not gathered.
+//! streaming read still holds: PLY and OFF keep their vertices (24 bytes each, the
+//! faces name them by number); STL keeps only the facet being read. Attribute values
+//! (per vertex, per face) are read and checked as by an ordinary read, but only the
+//! record being read is kept. OBJ and glTF are not streamed yet: they are read whole,
+//! as an ordinary read reads them, and their triangles handed on afterwards.
 //!
 //! A triangle whose corners are not all known when it is read (a PLY file with its
-//! faces before its vertices, an OBJ face naming a vertex defined later in its
-//! section) waits, 12 bytes a triangle, until they are: the end of the file, the end
-//! of the OBJ section. So the sink sees the file's triangles in the file's order
-//! except for those, which follow later.
+//! faces before its vertices) waits, 16 bytes a triangle, until the end of the file.
+//! So the sink sees the file's triangles in the file's order except for those, which
+//! follow later; and such a file's triangles are all held while it is read.
 //!
 //! The sink sees triangles before the end of the file says whether the file is valid:
 //! a streaming read that ends in an error has handed on some triangles, which the
@@ -33,7 +31,8 @@ use crate::MAX_ELEMENTS;
 /// Where a streaming read ([`stream_path`](super::stream_path)) sends each triangle.
 pub trait TriangleSink {
     /// Takes one triangle, as its three corners' positions (in the file's corner
-    /// order). An error stops the read: it is what the read returns.
+    /// order). An error stops the read (at the reader's next record for PLY, OFF and
+    /// STL; OBJ and glTF are read whole first): it is what the read returns.
     fn triangle(&mut self, corners: [[f64; 3]; 3]) -> Result<(), IoError>;
 }
 
@@ -94,6 +93,29 @@ impl<'s> Triangles<'s> {
                 made: 0,
             }),
         }
+    }
+
+    /// Whether the sink refused a triangle: the reader should stop
+    /// ([`Triangles::stopped`]); the read's error is the sink's.
+    #[inline]
+    pub(crate) fn has_failed(&self) -> bool {
+        self.stream.as_ref().is_some_and(|s| s.failed.is_some())
+    }
+
+    /// The error a reader gives up with once [`has_failed`](Self::has_failed): a
+    /// stand-in, which the streaming read replaces by the sink's error.
+    pub(crate) fn stopped() -> ReadError {
+        ReadError::new(
+            super::ReadErrorKind::Malformed {
+                detail: "the read stopped: the sink refused a triangle".into(),
+            },
+            None,
+        )
+    }
+
+    /// The sink's error, if it refused a triangle (taken).
+    pub(crate) fn take_failure(&mut self) -> Option<IoError> {
+        self.stream.as_mut().and_then(|s| s.failed.take())
     }
 
     /// Whether the triangles go to a sink (a streaming read).
@@ -313,21 +335,40 @@ mod tests {
         );
     }
 
-    /// The sink's error is the read's, and nothing is handed on after it.
+    /// The sink's error is the read's, even when the data goes wrong after it (the
+    /// reader stops at its next record), and nothing is handed on after it.
     #[test]
     fn a_sink_error_ends_the_read() {
-        let off = b"OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n";
-        let mut sink = Collect {
-            refuse: Some(1),
-            ..Collect::default()
-        };
-        match stream_bytes(off, Format::Off, &mut sink) {
-            Err(StreamBytesError::Sink(e)) => {
-                assert_eq!(e.to_string(), "spill: cannot write: disk full")
+        let off = b"OFF\n4 3 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n3 0 x 1\n";
+        assert!(
+            read_bytes(off, Format::Off).is_err(),
+            "the third face is malformed"
+        );
+        for format in [Format::Off, Format::Stl, Format::Ply] {
+            let data = match format {
+                Format::Off => off.to_vec(),
+                _ => {
+                    let mesh = crate::IndexedMesh::new(
+                        vec![[0.0; 3], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
+                        vec![[0, 1, 2], [0, 2, 3], [1, 2, 3]],
+                    );
+                    let mut bytes = Vec::new();
+                    crate::io::write_to(&mut bytes, &mesh, format).unwrap();
+                    bytes
+                }
+            };
+            let mut sink = Collect {
+                refuse: Some(1),
+                ..Collect::default()
+            };
+            match stream_bytes(&data, format, &mut sink) {
+                Err(StreamBytesError::Sink(e)) => {
+                    assert_eq!(e.to_string(), "spill: cannot write: disk full")
+                }
+                other => panic!("{format:?}: expected the sink's error, got {other:?}"),
             }
-            other => panic!("expected the sink's error, got {other:?}"),
+            assert_eq!(sink.corners.len(), 1, "{format:?}");
         }
-        assert_eq!(sink.corners.len(), 1);
     }
 
     /// A streaming read of an STL soup keeps no vertex between facets, and the

@@ -8,7 +8,9 @@
 //! - `room`: the triangles an in-core run can hold within the budget. A mesh of at most
 //!   `room` triangles is simplified in core, as without a budget.
 //! - Otherwise, a **round**: the mesh is split into tiles of at most `room` triangles
-//!   ([`super::jobs::split_mesh`], in a temporary directory), each tile is simplified
+//!   (about, past 2^20 triangles: see [`TileCount::MaxTriangles`]; in a temporary
+//!   directory: a file's first round as [`super::jobs::split`] cuts it, a mesh's as
+//!   [`super::jobs::split_mesh`]), each tile is simplified
 //!   to the ratio that leaves `keep = max(target, room × MERGED_SHARE)` triangles in
 //!   all, and the tiles are merged. The merged mesh keeps each tile's border strip
 //!   (the locked border vertices and their neighbours), which is why it aims below

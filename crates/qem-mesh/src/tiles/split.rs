@@ -15,12 +15,20 @@
 //!    border vertex is one at a border position) and handed to the caller.
 //!
 //! It gives the tiles [`Tiling`](super::Tiling) gives for the same triangles (the same
-//! cut, the same numbering), without the mesh. What it holds: the sample (at most
+//! cut, the same numbering), without the mesh; but for zero coordinates, whose sign
+//! a tile file keeps as its first corner there has it, where `Tiling` keeps the
+//! welded vertex's. What it holds: the sample (at most
 //! [`SAMPLE_CAP`](super::SAMPLE_CAP) centroids, 32 bytes each) and a buffer per tile
 //! while the triangles come; then one tile at a time (its positions' bits to sort, 72
 //! bytes a triangle; then the tile being numbered). On disk, in a temporary directory
 //! inside the tile directory (removed at the end, or by the next split if the process
 //! was killed): 72 bytes a triangle twice over while routing, then once.
+//!
+//! Files open at once: one per tile while routing, two per tile while the borders are
+//! found. The process's soft limit on open files is raised towards its hard limit
+//! when the split needs more (the `rlimit` crate); a split that would still need more
+//! than the system allows is refused before it writes a tile file, saying how many
+//! (often 1,024 by default, so about 480 tiles, before raising).
 
 use super::{centroid, position_key, Cut, Sample, Tile, TileBuilder};
 use crate::io::{IoError, TriangleSink};
@@ -54,9 +62,11 @@ pub(super) struct Spilled {
 
 /// The spill's sink: each triangle to the spill file, its centroid to the sample.
 pub(super) struct Spill {
+    /// (Before `dir`: fields drop in order, and a directory with an open file in it
+    /// cannot be removed everywhere.)
+    out: BufWriter<File>,
     dir: tempfile::TempDir,
     path: PathBuf,
-    out: BufWriter<File>,
     sample: Sample,
     count: u64,
     bbox: Box3,
@@ -205,6 +215,7 @@ impl Spilled {
             ..
         } = self;
         let tiles = tiles.clamp(1, (triangles as usize).max(1));
+        open_files_for(tiles, dir.path().parent().unwrap_or(dir.path()))?;
         let cut = Cut::new(sample, tiles);
         let mut buckets = Vec::with_capacity(tiles);
         let mut outs = Vec::with_capacity(tiles);
@@ -357,6 +368,29 @@ impl Routed {
             builder.push(corners.map(|p| (p, border.binary_search(&position_key(p)).is_ok())));
         }
         Ok((builder.finish(), centroids))
+    }
+}
+
+/// Files a split may hold open beside its tiles' (the input, the spill, the standard
+/// streams and what the caller has open).
+const SPARE_FILES: u64 = 64;
+
+/// Makes sure the process may open the files a split into `tiles` tiles holds at
+/// once (two per tile while the borders are found), raising its soft limit when it
+/// can; the error says what is needed and allowed, naming `dir`.
+fn open_files_for(tiles: usize, dir: &Path) -> Result<(), IoError> {
+    let needed = 2 * tiles as u64 + SPARE_FILES;
+    match rlimit::increase_nofile_limit(needed) {
+        Ok(allowed) if allowed < needed => Err(file_error(
+            dir,
+            "split into tiles in",
+            std::io::Error::other(format!(
+                "{tiles} tiles need about {needed} open files at once, and the system allows \
+                 {allowed} (raise it with `ulimit -n`, or ask for fewer tiles)"
+            )),
+        )),
+        // (Where the limit cannot be read, opening the files will tell.)
+        _ => Ok(()),
     }
 }
 
