@@ -151,12 +151,15 @@ def split(
     tile_triangles: Optional[int] = None,
     tiles: Optional[int] = None,
 ) -> Manifest:
-    """Cuts the mesh file ``input`` (any format :func:`qem.load` reads; read whole) into
-    spatial tiles in ``directory`` (created if missing), and returns the manifest.
+    """Cuts the mesh file ``input`` (any format :func:`qem.load` reads) into spatial
+    tiles in ``directory`` (created if missing), and returns the manifest. The file is
+    streamed to a temporary directory inside ``directory`` as it is read (PLY, OFF and
+    STL without holding their triangles; OBJ and glTF are read whole first).
 
     ``tile_triangles``: at most this many triangles per tile (default 1,000,000: a
     tile's simplification then takes about 200 MB); or ``tiles``: this many tiles, of
-    equal triangle counts within one. Vertices with bit-identical positions are merged
+    equal triangle counts within one (within a fraction of a percent past 2^20
+    triangles, where the cut is made from a sample of the centroids). Vertices with bit-identical positions are merged
     first (so an STL soup's tiles find their shared vertices), and the triangles are cut
     by a k-d bisection of their centroids. The same input gives the same files, bit for
     bit. An earlier split in ``directory`` is replaced; its done tiles stay done when
