@@ -134,28 +134,7 @@ impl IndexedMesh {
     /// labels in range). Reports the first problem found: vertices, then faces, then
     /// attributes.
     pub fn validate(&self) -> Result<(), InputError> {
-        for (what, count) in [
-            ("vertices", self.positions.len()),
-            ("triangles", self.triangles.len()),
-        ] {
-            if count > MAX_ELEMENTS {
-                return Err(InputError::TooLarge {
-                    what,
-                    count,
-                    limit: MAX_ELEMENTS,
-                });
-            }
-        }
-        if self.triangles.is_empty() {
-            return Err(InputError::NoTriangles);
-        }
-        if let Some(vertex) = self
-            .positions
-            .iter()
-            .position(|p| !p.iter().all(|c| c.is_finite()))
-        {
-            return Err(InputError::NonFiniteCoordinate { vertex });
-        }
+        check_vertices(&self.positions, 0, self.triangles.len())?;
         let vertex_count = self.positions.len();
         for (face, tri) in self.triangles.iter().enumerate() {
             for &index in tri {
@@ -186,6 +165,41 @@ impl IndexedMesh {
             }
         }
         Some((lo, hi))
+    }
+}
+
+/// The checks of [`IndexedMesh::validate`] that need no triangle list, in its order:
+/// the counts (`vertices` is `first` plus the positions given: a streaming read may
+/// have let the first ones go, having checked them), at least one triangle, finite
+/// coordinates (a vertex numbered from `first`).
+pub(crate) fn check_vertices(
+    positions: &[[f64; 3]],
+    first: usize,
+    triangles: usize,
+) -> Result<(), InputError> {
+    for (what, count) in [
+        ("vertices", first + positions.len()),
+        ("triangles", triangles),
+    ] {
+        if count > MAX_ELEMENTS {
+            return Err(InputError::TooLarge {
+                what,
+                count,
+                limit: MAX_ELEMENTS,
+            });
+        }
+    }
+    if triangles == 0 {
+        return Err(InputError::NoTriangles);
+    }
+    match positions
+        .iter()
+        .position(|p| !p.iter().all(|c| c.is_finite()))
+    {
+        Some(vertex) => Err(InputError::NonFiniteCoordinate {
+            vertex: first + vertex,
+        }),
+        None => Ok(()),
     }
 }
 

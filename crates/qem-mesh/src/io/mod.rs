@@ -337,18 +337,10 @@ fn read_input(
     format: Format,
     external: Option<gltf::External<'_>>,
 ) -> Result<LoadedMesh, ReadError> {
-    to_the_end(input, |input| read_plain(input, format, external))
-}
-
-/// Runs `read` on `input`, then reads a gzip stream to its end: a gzip error anywhere
-/// in the stream wins over what the reader found.
-fn to_the_end<T, E: From<ReadError>>(
-    input: &mut Input<'_>,
-    read: impl FnOnce(&mut Input<'_>) -> Result<T, E>,
-) -> Result<T, E> {
-    let result = read(input);
+    let read = read_plain(input, format, external);
+    // A gzip error anywhere in the stream wins over what the reader found.
     input.finish()?;
-    result
+    read
 }
 
 fn read_plain(
@@ -358,10 +350,8 @@ fn read_plain(
 ) -> Result<LoadedMesh, ReadError> {
     let mut triangles = Triangles::kept();
     let (mut mesh, notes) = parse(input, format, external, &mut triangles)?;
-    // (OBJ and glTF fill the mesh's list themselves.)
-    let kept = triangles.into_kept();
-    if !kept.is_empty() {
-        mesh.triangles = kept;
+    if hands_on_triangles(format) {
+        mesh.triangles = triangles.into_kept();
     }
     let loaded = LoadedMesh { mesh, notes };
     // The parsers report most problems with a place; this is the safety net that makes
@@ -420,22 +410,15 @@ fn stream_plain(
             })
         }
     };
-    if !mesh.triangles.is_empty() {
-        // OBJ and glTF are read whole (their readers do not hand triangles on yet):
-        // checked as an ordinary read is, then handed on.
+    if !hands_on_triangles(format) {
+        // Read whole: checked as an ordinary read is, then handed on.
         mesh.validate().map_err(|e| ReadError::mesh(None, e))?;
         for &t in &mesh.triangles {
             triangles.push(t, &mesh.positions);
         }
     }
     let triangle_count = triangles.len();
-    let vertices =
-        triangles
-            .finish(&mesh.positions)
-            .map_err(|end| match end.into_read_error() {
-                Ok(e) => StreamError::Read(e),
-                Err(e) => StreamError::Sink(e),
-            })?;
+    let vertices = triangles.finish(&mesh.positions)?;
     Ok(Streamed {
         vertices,
         triangles: triangle_count,
@@ -444,9 +427,15 @@ fn stream_plain(
     })
 }
 
-/// Parses `input` in `format`: the mesh and what was passed over. PLY, STL and OFF
-/// give their triangles to `triangles` (the mesh's list stays empty); OBJ and glTF
-/// fill the mesh's list.
+/// Whether the reader of `format` gives its triangles to a [`Triangles`] as it reads
+/// them (PLY, STL, OFF), rather than filling the mesh's list (OBJ and glTF, read whole
+/// for now).
+fn hands_on_triangles(format: Format) -> bool {
+    matches!(format, Format::Ply | Format::Stl | Format::Off)
+}
+
+/// Parses `input` in `format`: the mesh and what was passed over, its triangles given
+/// to `triangles` or in the mesh's list ([`hands_on_triangles`]).
 fn parse(
     input: &mut Input<'_>,
     format: Format,

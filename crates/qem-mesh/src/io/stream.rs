@@ -19,14 +19,16 @@
 //! a streaming read that ends in an error has handed on some triangles, which the
 //! caller must discard. A read that succeeds has checked what
 //! [`IndexedMesh::validate`](crate::IndexedMesh::validate) checks of the mesh
-//! [`read_path`](super::read_path) would have returned (it fails exactly when that
-//! read fails), and the sink has seen exactly that mesh's triangles, as the positions
-//! of their corners.
+//! [`read_path`](super::read_path) would have returned but its attributes (which
+//! the PLY, OFF and STL readers check as they read them), and the sink has seen
+//! exactly that mesh's triangles, as the positions of their corners. That the two
+//! reads fail alike, with the same message, is tested on every fuzz input and
+//! regression of the readers, truncated and in chunks (`io::input`'s tests, and the
+//! fuzz targets' checks).
 
 use super::error::{IoError, ReadError};
-use super::ReadNotes;
-use crate::input::InputError;
-use crate::MAX_ELEMENTS;
+use super::{ReadNotes, StreamError};
+use crate::input::{check_vertices, InputError};
 
 /// Where a streaming read ([`stream_path`](super::stream_path)) sends each triangle.
 pub trait TriangleSink {
@@ -150,17 +152,8 @@ impl<'s> Triangles<'s> {
         };
         let number = stream.made as u32;
         stream.made += 1;
-        if stream.failed.is_some() {
-            return;
-        }
-        let local = t.map(|i| (i as usize).checked_sub(stream.forgotten));
-        match local.map(|i| i.and_then(|i| positions.get(i).copied())) {
-            [Some(a), Some(b), Some(c)] => {
-                if let Err(e) = stream.sink.triangle([a, b, c]) {
-                    stream.failed = Some(e);
-                }
-            }
-            _ => stream.waiting.push((number, t)),
+        if !stream.hand_on(t, positions) {
+            stream.waiting.push((number, t));
         }
     }
 
@@ -171,24 +164,9 @@ impl<'s> Triangles<'s> {
         let Some(stream) = &mut self.stream else {
             return;
         };
-        let mut still = Vec::new();
-        for (number, t) in std::mem::take(&mut stream.waiting) {
-            let corners = t.map(|i| {
-                (i as usize)
-                    .checked_sub(stream.forgotten)
-                    .and_then(|i| positions.get(i).copied())
-            });
-            match corners {
-                [Some(a), Some(b), Some(c)] if stream.failed.is_none() => {
-                    if let Err(e) = stream.sink.triangle([a, b, c]) {
-                        stream.failed = Some(e);
-                    }
-                }
-                [Some(_), Some(_), Some(_)] => {}
-                _ => still.push((number, t)),
-            }
-        }
-        stream.waiting = still;
+        let mut waiting = std::mem::take(&mut stream.waiting);
+        waiting.retain(|&(_, t)| !stream.hand_on(t, positions));
+        stream.waiting = waiting;
     }
 
     /// For a reader whose triangles never name an earlier facet's vertices (STL):
@@ -221,66 +199,54 @@ impl<'s> Triangles<'s> {
     /// The end of a streaming read whose reader gave `positions` (the mesh's, with
     /// the vertices it forgot not among them): hands on what waited, then checks
     /// what [`IndexedMesh::validate`](crate::IndexedMesh::validate) checks of the
-    /// mesh an ordinary read gives, and the sink's error. Returns the vertex count.
-    pub(crate) fn finish(mut self, positions: &[[f64; 3]]) -> Result<usize, StreamEnd> {
+    /// mesh an ordinary read gives (but its attributes), after the sink's error.
+    /// Returns the vertex count.
+    pub(crate) fn finish(mut self, positions: &[[f64; 3]]) -> Result<usize, StreamError> {
         self.settle(positions);
         let Some(stream) = self.stream else {
             return Ok(positions.len());
         };
+        // (The sink's error first, as wherever else it meets one of the data.)
+        if let Some(e) = stream.failed {
+            return Err(StreamError::Sink(e));
+        }
+        let mesh_error = |e| StreamError::Read(ReadError::mesh(None, e));
+        check_vertices(positions, stream.forgotten, stream.made).map_err(mesh_error)?;
         let vertex_count = stream.forgotten + positions.len();
-        for (what, count) in [("vertices", vertex_count), ("triangles", stream.made)] {
-            if count > MAX_ELEMENTS {
-                return Err(StreamEnd::Input(InputError::TooLarge {
-                    what,
-                    count,
-                    limit: MAX_ELEMENTS,
-                }));
-            }
-        }
-        if stream.made == 0 {
-            return Err(StreamEnd::Input(InputError::NoTriangles));
-        }
-        if let Some(vertex) = positions
-            .iter()
-            .position(|p| !p.iter().all(|c| c.is_finite()))
-        {
-            return Err(StreamEnd::Input(InputError::NonFiniteCoordinate {
-                vertex: vertex + stream.forgotten,
-            }));
-        }
         if let Some(&(face, t)) = stream.waiting.first() {
             let index = t
                 .into_iter()
                 .find(|&i| i as usize >= vertex_count)
                 .unwrap_or(t[0]);
-            return Err(StreamEnd::Input(InputError::IndexOutOfRange {
+            return Err(mesh_error(InputError::IndexOutOfRange {
                 face: face as usize,
                 index,
                 vertex_count,
             }));
         }
-        match stream.failed {
-            Some(e) => Err(StreamEnd::Sink(e)),
-            None => Ok(vertex_count),
-        }
+        Ok(vertex_count)
     }
 }
 
-/// Why a streaming read that its reader finished still fails.
-pub(crate) enum StreamEnd {
-    /// The mesh breaks a rule of [`IndexedMesh::validate`](crate::IndexedMesh::validate).
-    Input(InputError),
-    /// The sink refused a triangle.
-    Sink(IoError),
-}
-
-impl StreamEnd {
-    /// As the error of a read of the data (the sink's error is the caller's to give).
-    pub(crate) fn into_read_error(self) -> Result<ReadError, IoError> {
-        match self {
-            StreamEnd::Input(e) => Ok(ReadError::mesh(None, e)),
-            StreamEnd::Sink(e) => Err(e),
+impl Stream<'_> {
+    /// Hands triangle `t` on when its corners are all in `positions` (offset by the
+    /// vertices forgotten), and says whether they were; nothing more goes to the sink
+    /// once it has refused a triangle.
+    fn hand_on(&mut self, t: [u32; 3], positions: &[[f64; 3]]) -> bool {
+        let corner = |i: u32| {
+            (i as usize)
+                .checked_sub(self.forgotten)
+                .and_then(|i| positions.get(i).copied())
+        };
+        let [Some(a), Some(b), Some(c)] = t.map(corner) else {
+            return false;
+        };
+        if self.failed.is_none() {
+            if let Err(e) = self.sink.triangle([a, b, c]) {
+                self.failed = Some(e);
+            }
         }
+        true
     }
 }
 

@@ -225,19 +225,37 @@ pub fn simplify_within(
     scratch: &Path,
     observer: &mut dyn Observer,
 ) -> Result<BudgetRun, BudgetError> {
-    run(First::Mesh(input), options, budget, scratch, observer)
+    run(
+        RoundInput::Mesh(input),
+        None,
+        options,
+        budget,
+        scratch,
+        observer,
+    )
 }
 
-/// What a budgeted run starts from: a mesh in memory, or a file's triangles already
-/// streamed to disk (too many to fit).
-enum First {
+/// What a round of tiles is cut from: a mesh in memory, or a file's triangles already
+/// streamed to disk (the first round of [`simplify_file_within`]).
+enum RoundInput {
     Mesh(SplitInput),
-    Spilled {
-        source: Source,
-        spilled: Spilled,
-        /// The temporary directory the spill is in.
-        work: tempfile::TempDir,
-    },
+    Spilled(Source, Spilled),
+}
+
+impl RoundInput {
+    fn triangles(&self) -> usize {
+        match self {
+            RoundInput::Mesh(input) => input.mesh.triangle_count(),
+            RoundInput::Spilled(_, spilled) => spilled.triangles as usize,
+        }
+    }
+
+    fn attributes_dropped(&self) -> bool {
+        match self {
+            RoundInput::Mesh(input) => !input.mesh.attributes.is_empty(),
+            RoundInput::Spilled(source, _) => source.attributes_dropped,
+        }
+    }
 }
 
 /// [`simplify_within`] for a file, which it reads itself so that a file too large
@@ -275,7 +293,14 @@ pub fn simplify_file_within(
             size_bytes,
             mesh: loaded.mesh,
         };
-        let run = run(First::Mesh(split), options, budget, scratch, observer)?;
+        let run = run(
+            RoundInput::Mesh(split),
+            None,
+            options,
+            budget,
+            scratch,
+            observer,
+        )?;
         return Ok(FileBudgetRun {
             run,
             triangles_in,
@@ -286,13 +311,9 @@ pub fn simplify_file_within(
         });
     }
     let load = clock.elapsed();
-    let first = First::Spilled {
-        source,
-        spilled,
-        work,
-    };
+    let first = RoundInput::Spilled(source, spilled);
     Ok(FileBudgetRun {
-        run: run(first, options, budget, scratch, observer)?,
+        run: run(first, Some(work), options, budget, scratch, observer)?,
         triangles_in,
         vertices_in,
         notes: streamed.notes,
@@ -337,18 +358,17 @@ fn work_directory(scratch: &Path) -> Result<tempfile::TempDir, IoError> {
         })
 }
 
-/// The run from `first` (see [`simplify_within`]).
+/// The run from `first` (see [`simplify_within`]); `work` is the temporary directory
+/// a spilled input is in (one is made in `scratch` when a mesh must be tiled).
 fn run(
-    first: First,
+    first: RoundInput,
+    work: Option<tempfile::TempDir>,
     options: &SimplifyOptions,
     budget: u64,
     scratch: &Path,
     observer: &mut dyn Observer,
 ) -> Result<BudgetRun, BudgetError> {
-    let triangles_in = match &first {
-        First::Mesh(input) => input.mesh.triangle_count(),
-        First::Spilled { spilled, .. } => spilled.triangles as usize,
-    };
+    let triangles_in = first.triangles();
     let target = options.target.triangles_for(triangles_in);
     let room = room_for(budget, options);
     let finish_target = match options.target {
@@ -356,9 +376,8 @@ fn run(
         _ => Target::Triangles(target),
     };
     let mut rounds: Vec<BudgetRound> = Vec::new();
-    let mut carried: Option<CarriedQuadrics> = None;
-    let mut mesh = match first {
-        First::Mesh(input) if triangles_in <= room => input.mesh,
+    let (mesh, carried) = match first {
+        RoundInput::Mesh(input) if triangles_in <= room => (input.mesh, None),
         first => {
             if options.method == Method::Clustering {
                 return Err(BudgetError::TooSmall {
@@ -384,53 +403,34 @@ fn run(
             // Checked before any file is written: a tile job refuses the same options.
             TileOptions::new(options.clone().with_target(Target::Ratio(0.5)))
                 .map_err(TilesError::from)?;
-            let (first_round, work) = match first {
-                First::Mesh(input) => {
-                    let needed = split_bytes(&input.mesh, room);
-                    if needed > budget {
-                        return Err(BudgetError::TooSmall {
-                            budget,
-                            needed,
-                            what: "cutting the mesh into tiles",
-                        });
-                    }
-                    (FirstRound::Mesh(input), work_directory(scratch)?)
+            if let RoundInput::Mesh(input) = &first {
+                let needed = split_bytes(&input.mesh, room);
+                if needed > budget {
+                    return Err(BudgetError::TooSmall {
+                        budget,
+                        needed,
+                        what: "cutting the mesh into tiles",
+                    });
                 }
-                First::Spilled {
-                    source,
-                    spilled,
-                    work,
-                } => (FirstRound::Spilled(source, spilled), work),
+            }
+            let work = match work {
+                Some(work) => work,
+                None => work_directory(scratch)?,
             };
-            let (mut mesh, quadrics) = tile_rounds(
-                first_round,
-                options,
-                room,
-                target,
-                budget,
-                &work,
-                &mut rounds,
-                observer,
+            let rounds = &mut rounds;
+            let (mesh, quadrics) = tile_rounds(
+                first, options, room, target, budget, &work, rounds, observer,
             )?;
-            drop(work);
-            carried = Some(quadrics);
-            std::mem::take(&mut mesh)
+            (mesh, Some(quadrics))
         }
     };
     let finish = options.clone().with_target(finish_target);
     let result = match carried {
         Some(carried) => {
             let origin = carried.origin;
-            simplify_carrying(
-                std::mem::take(&mut mesh),
-                &finish,
-                Some(carried),
-                origin,
-                observer,
-            )?
-            .0
+            simplify_carrying(mesh, &finish, Some(carried), origin, observer)?.0
         }
-        None => simplify_owned(std::mem::take(&mut mesh), &finish, observer)?,
+        None => simplify_owned(mesh, &finish, observer)?,
     };
     Ok(BudgetRun {
         result,
@@ -441,18 +441,12 @@ fn run(
     })
 }
 
-/// What a budgeted run's first round of tiles is cut from.
-enum FirstRound {
-    Mesh(SplitInput),
-    Spilled(Source, Spilled),
-}
-
 /// Rounds of tiles in `work` until the merged mesh fits in `room` triangles: the first
 /// cut from `first`, the later ones from the merged mesh of the round before. Returns
 /// the last merged mesh and its vertices' quadrics; each round goes to `rounds`.
 #[allow(clippy::too_many_arguments)]
 fn tile_rounds(
-    first: FirstRound,
+    first: RoundInput,
     options: &SimplifyOptions,
     room: usize,
     target: usize,
@@ -494,7 +488,7 @@ fn tile_rounds(
         // The split cuts meshes only: this round's quadrics are not needed again, and
         // not held through the next.
         drop(quadrics);
-        input = FirstRound::Mesh(SplitInput {
+        input = RoundInput::Mesh(SplitInput {
             // What the next round's manifest names as its input: no file.
             name: format!("the merged tiles of round {}", rounds.len()),
             size_bytes: 0,
@@ -533,30 +527,22 @@ fn attribute_bytes(mesh: &IndexedMesh) -> u64 {
 /// simplified to leave `max(target, room × MERGED_SHARE)` triangles in all, merged;
 /// the merged mesh comes with its vertices' quadrics.
 fn tile_round(
-    input: FirstRound,
+    input: RoundInput,
     options: &SimplifyOptions,
     room: usize,
     target: usize,
     dir: &Path,
     observer: &mut dyn Observer,
 ) -> Result<(BudgetRound, IndexedMesh, CarriedQuadrics), BudgetError> {
-    let (triangles_in, attributes_dropped) = match &input {
-        FirstRound::Mesh(input) => (
-            input.mesh.triangle_count(),
-            !input.mesh.attributes.is_empty(),
-        ),
-        FirstRound::Spilled(source, spilled) => {
-            (spilled.triangles as usize, source.attributes_dropped)
-        }
-    };
+    let (triangles_in, attributes_dropped) = (input.triangles(), input.attributes_dropped());
     let keep = target.max((room as f64 * MERGED_SHARE) as usize);
     let tile_ratio = keep as f64 / triangles_in as f64;
     let tile_options = TileOptions::new(options.clone().with_target(Target::Ratio(tile_ratio)))
         .map_err(TilesError::from)?;
     let count = TileCount::MaxTriangles(room);
     match input {
-        FirstRound::Mesh(input) => split_mesh(input, dir, count, observer)?,
-        FirstRound::Spilled(source, spilled) => {
+        RoundInput::Mesh(input) => split_mesh(input, dir, count, observer)?,
+        RoundInput::Spilled(source, spilled) => {
             split_spilled(source, spilled, dir, count, observer)?
         }
     };
