@@ -36,7 +36,7 @@ enum TilesCommand {
 /// Arguments of `qem tiles split`.
 #[derive(Args, Debug)]
 struct SplitArgs {
-    /// Input mesh (.obj .ply .stl .off .gltf .glb, optionally .gz); streamed to a temporary directory in DIR (PLY, OFF and STL without holding its triangles; OBJ and glTF read whole first).
+    /// Input mesh (.obj .ply .stl .off .gltf .glb, optionally .gz); streamed to a temporary directory in DIR (PLY, OFF, STL and OBJ without holding its triangles; glTF read whole first).
     input: PathBuf,
     /// Directory for the tiles and the manifest (created if missing).
     dir: PathBuf,

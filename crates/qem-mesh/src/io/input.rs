@@ -4,10 +4,10 @@
 //! so many ([`Input::fill`]), parses whole records out of the window, and consumes them
 //! ([`Input::consume`]); the window is refilled from the source a chunk at a time, so a
 //! binary PLY or STL file is read without holding the file, or its decompressed bytes,
-//! in memory. OFF, ASCII PLY and ASCII STL read whole lines or tokens out of the window
-//! the same way ([`super::text::TextStream`]). Data in memory is its own window (nothing is copied),
-//! and a reader that needs all of its data at once (OBJ, glTF) takes the rest with
-//! [`Input::rest`].
+//! in memory. OFF, OBJ, ASCII PLY and ASCII STL read whole lines or tokens out of the
+//! window the same way ([`super::text::TextStream`]). Data in memory is its own window
+//! (nothing is copied), and a reader that needs all of its data at once (glTF) takes the
+//! rest with [`Input::rest`].
 //!
 //! Gzip data is decompressed as it is read, with the caps of [`GZIP_MAX_RATIO`] and
 //! [`GZIP_MAX_BYTES`]. Before streaming, the readers decompressed the whole file first,
@@ -490,10 +490,12 @@ fn is_gzip(bytes: &[u8]) -> bool {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     //! Reading in small chunks, from a reader whose size is known or not, gives what
     //! reading the same bytes from memory gives (where a window is all the data), on
-    //! inputs whose records straddle chunks, truncated ones, wrong and huge counts.
+    //! inputs whose records straddle chunks, truncated ones, wrong and huge counts; and
+    //! a streaming read gives what the ordinary read gives ([`check`], which the
+    //! readers' own tests call too).
 
     use std::io::Write;
 
@@ -524,10 +526,11 @@ mod tests {
         read_input(&mut input, format, None)
     }
 
-    /// The same result in memory and chunked. A corrupt gzip stream's message says how
-    /// many bytes were decompressed before the error, which depends on how much was
-    /// asked at a time: only its text without digits is compared.
-    fn check(data: &[u8], format: Format, chunk: usize, sized: bool, what: &str) {
+    /// The same result in memory and chunked, and streamed ([`check_streamed`]). A
+    /// corrupt gzip stream's message says how many bytes were decompressed before the
+    /// error, which depends on how much was asked at a time: only its text without
+    /// digits is compared.
+    pub(crate) fn check(data: &[u8], format: Format, chunk: usize, sized: bool, what: &str) {
         let whole = read_bytes(data, format);
         let parts = chunked(data, format, chunk, sized);
         let gzip_corrupt = |r: &Result<LoadedMesh, ReadError>| match r {

@@ -31,9 +31,9 @@
 //!
 //! **Triangles as they are read.** [`stream_path`] (and [`stream_bytes`]) read as
 //! [`read_path`] does but hand each triangle to a [`TriangleSink`] instead of keeping
-//! a list: PLY, OFF and STL without holding their triangles (see `io::stream`); OBJ
-//! and glTF are read whole first, for now. `qem tiles split` and `--memory-budget`
-//! cut files into tiles this way.
+//! a list: PLY, OFF, STL and OBJ without holding their triangles (see `io::stream`);
+//! glTF is read whole first. `qem tiles split` and `--memory-budget` cut files into
+//! tiles this way.
 //!
 //! Polygons are fan-triangulated from their first corner. Vertices are never welded
 //! or removed by the PLY, STL and OFF readers (an STL facet gives three new vertices);
@@ -349,8 +349,10 @@ fn read_plain(
     external: Option<gltf::External<'_>>,
 ) -> Result<LoadedMesh, ReadError> {
     let mut triangles = Triangles::kept();
-    let (mut mesh, notes) = parse(input, format, external, &mut triangles)?;
-    if hands_on_triangles(format) {
+    let Parsed {
+        mut mesh, notes, ..
+    } = parse(input, format, external, &mut triangles)?;
+    if hands_on_triangles(format, false) {
         mesh.triangles = triangles.into_kept();
     }
     let loaded = LoadedMesh { mesh, notes };
@@ -400,7 +402,7 @@ fn stream_plain(
     sink: &mut dyn TriangleSink,
 ) -> Result<Streamed, StreamError> {
     let mut triangles = Triangles::streamed(sink);
-    let (mesh, notes) = match parse(input, format, external, &mut triangles) {
+    let parsed = match parse(input, format, external, &mut triangles) {
         Ok(parsed) => parsed,
         // A reader that stopped for the sink's error gives that error.
         Err(e) => {
@@ -410,7 +412,8 @@ fn stream_plain(
             })
         }
     };
-    if !hands_on_triangles(format) {
+    let Parsed { mesh, notes, names } = parsed;
+    if !hands_on_triangles(format, true) {
         // Read whole: checked as an ordinary read is, then handed on.
         mesh.validate().map_err(|e| ReadError::mesh(None, e))?;
         for &t in &mesh.triangles {
@@ -423,15 +426,32 @@ fn stream_plain(
         vertices,
         triangles: triangle_count,
         notes,
-        attributes: mesh.attributes.names(),
+        attributes: names.unwrap_or_else(|| mesh.attributes.names()),
     })
 }
 
 /// Whether the reader of `format` gives its triangles to a [`Triangles`] as it reads
-/// them (PLY, STL, OFF), rather than filling the mesh's list (OBJ and glTF, read whole
-/// for now).
-fn hands_on_triangles(format: Format) -> bool {
-    matches!(format, Format::Ply | Format::Stl | Format::Off)
+/// them, in a streaming read or an ordinary one: PLY, STL and OFF in both; OBJ only
+/// when streaming (an ordinary read keeps its own list, which the corners of its
+/// attributes follow); glTF in neither (read whole, then handed on).
+fn hands_on_triangles(format: Format, streaming: bool) -> bool {
+    match format {
+        Format::Ply | Format::Stl | Format::Off => true,
+        Format::Obj => streaming,
+        Format::Gltf | Format::Glb => false,
+    }
+}
+
+/// What [`parse`] read.
+struct Parsed {
+    /// The mesh, with or without its triangles ([`hands_on_triangles`]).
+    mesh: IndexedMesh,
+    /// What was passed over.
+    notes: ReadNotes,
+    /// The names of what the file carries besides positions, when the mesh cannot
+    /// show them ([`Attributes::names`](crate::attributes::Attributes::names) of the
+    /// mesh otherwise): a streamed OBJ drops its per-face labels.
+    names: Option<Vec<String>>,
 }
 
 /// Parses `input` in `format`: the mesh and what was passed over, its triangles given
@@ -441,7 +461,7 @@ fn parse(
     format: Format,
     external: Option<gltf::External<'_>>,
     triangles: &mut Triangles<'_>,
-) -> Result<(IndexedMesh, ReadNotes), ReadError> {
+) -> Result<Parsed, ReadError> {
     input.fill(1)?;
     if input.window().is_empty() {
         return Err(ReadError::new(ReadErrorKind::Empty, None));
@@ -454,14 +474,17 @@ fn parse(
     }
     // PLY, STL, OFF and OBJ are read as they arrive; glTF (JSON, and buffers anywhere in
     // it) from all its bytes.
-    let mesh = match format {
-        Format::Obj => obj::read(input, &mut notes)?,
-        Format::Ply => ply::read(input, &mut notes, triangles)?,
-        Format::Stl => stl::read(input, &mut notes, triangles)?,
-        Format::Off => off::read(input, &mut notes, triangles)?,
-        Format::Gltf | Format::Glb => gltf::read(&input.rest()?, format, external, &mut notes)?,
+    let (mesh, names) = match format {
+        Format::Obj => obj::read(input, &mut notes, triangles)?,
+        Format::Ply => (ply::read(input, &mut notes, triangles)?, None),
+        Format::Stl => (stl::read(input, &mut notes, triangles)?, None),
+        Format::Off => (off::read(input, &mut notes, triangles)?, None),
+        Format::Gltf | Format::Glb => (
+            gltf::read(&input.rest()?, format, external, &mut notes)?,
+            None,
+        ),
     };
-    Ok((mesh, notes))
+    Ok(Parsed { mesh, notes, names })
 }
 
 /// Reads a mesh file; the format comes from the name ([`Format::from_path`]),
@@ -524,8 +547,8 @@ fn from_file<T>(
 
 /// Reads a mesh file as [`read_path`] does, but hands each triangle to `sink` as it is
 /// read instead of keeping a list of them (see [`TriangleSink`] for what is held
-/// meanwhile: for PLY, OFF and STL, the vertices at most; OBJ and glTF are read whole
-/// for now, then handed on). It fails exactly when [`read_path`] fails, with the same
+/// meanwhile: for PLY, OFF, STL and OBJ, the vertices at most; glTF is read whole,
+/// then handed on). It fails exactly when [`read_path`] fails, with the same
 /// error, or when the sink fails, with the sink's; either way the sink may have been
 /// given triangles first, which the caller must discard. On success the sink has seen
 /// every triangle of the mesh [`read_path`] gives, as the positions of its corners,

@@ -67,6 +67,13 @@
 //! `tobj` took 8.6 and 4.7 times: BENCHMARKS.md, "Loading"). Colours are gathered
 //! into a new array (12 bytes per vertex more, only for files with colours).
 //!
+//! A streaming read (`io::stream`) holds the same per element of the file, but no
+//! triangle (nor its corners' texture coordinates and normals) once every element its
+//! section has named so far is read: the triangles are then handed on, each corner as
+//! its vertex's position. Those that name an element not read yet are held until it
+//! is (at the latest, their section's end); so are the triangles after them, so that
+//! the sink sees the file's order.
+//!
 //! # Differences from the reader built on `tobj`
 //! The old reader is kept for tests (`io::obj_legacy`), which check on random files,
 //! the fuzz inputs and the corpus that both give the same meshes, notes and errors
@@ -103,9 +110,11 @@ use std::ops::Range;
 use rustc_hash::FxHashMap;
 
 use super::input::Input;
+use super::stream::Triangles;
 use super::text::{self, parse_f64, parse_i64, show, words, TextStream};
 use super::{Format, Location, ReadError, ReadErrorKind, ReadNotes, SNIFF_HEAD};
-use crate::attributes::{Channel, ChannelKind, FaceLabels};
+use crate::attributes::{Attributes, Channel, ChannelKind, FaceLabels};
+use crate::input::check_vertices;
 use crate::{IndexedMesh, InputError, MAX_ELEMENTS};
 
 /// No output element (in the maps from file elements to output elements).
@@ -415,14 +424,21 @@ pub(super) fn expand_runs(runs: &[LabelRun], triangles: usize) -> Vec<u32> {
 }
 
 /// Corners of a texture-coordinate or normal channel, made when the first corner has
-/// a value (a file without `vt` holds no corners for them).
+/// a value (a file without `vt` holds no corners for them), for the triangles the
+/// reader holds (all of them in an ordinary read; see [`Reader::held_from`]).
 #[derive(Default)]
 struct Corners {
     corners: Vec<[u32; 3]>,
     active: bool,
+    /// Whether a corner of the current section has a value.
+    section_values: bool,
+    /// Whether a section kept so far had a corner with a value: the mesh has the
+    /// channel.
+    kept_values: bool,
 }
 
 impl Corners {
+    /// Adds the corners of held triangle `t` (counted from the first held one).
     fn push(&mut self, t: usize, c: [u32; 3]) {
         if !self.active {
             if c == [Channel::MISSING; 3] {
@@ -431,29 +447,58 @@ impl Corners {
             self.active = true;
             self.corners.resize(t, [Channel::MISSING; 3]);
         }
+        self.section_values |= c != [Channel::MISSING; 3];
         self.corners.push(c);
     }
 
-    /// Marks the corners of triangles `from..` missing.
-    fn clear_from(&mut self, from: usize) {
-        if let Some(span) = self.corners.get_mut(from..) {
+    /// Ends a section: its values are the mesh's (`kept`), or marked missing from held
+    /// triangle `from` on.
+    fn end_section(&mut self, kept: bool, from: usize) {
+        if kept {
+            self.kept_values |= self.section_values;
+        } else if let Some(span) = self.corners.get_mut(from..) {
             span.fill([Channel::MISSING; 3]);
         }
+        self.section_values = false;
     }
 }
 
 /// A face corner's indices as written (0: slot empty).
 type Corner = [i64; 3];
 
+/// Where a streaming read handed on the current section's first triangles (see
+/// [`Reader::flush`]): what [`Reader::first_out_of_bounds`] needs to know of them.
+#[derive(Clone, Copy)]
+struct Flushed {
+    /// The number of output elements of each list made by then (the next new one).
+    next: [u32; 3],
+    /// The largest file vertex given an output vertex in the section by then.
+    max_vertex: u32,
+}
+
 /// Everything the reader keeps between lines.
-struct Reader {
+struct Reader<'a, 's> {
     v: List<[f64; 3]>,
     vt: List<f32>,
     vn: List<f32>,
     /// `v x y z r g b` colours, three numbers per `v` line that has them (an
     /// unparsable one ends its line's: as `tobj` did).
     colours: Vec<f32>,
+    /// The triangles held, from triangle number `held_from` on, as output vertices:
+    /// every triangle in an ordinary read; in a streaming read, those not handed on
+    /// yet (see [`Reader::flush`]).
     triangles: Vec<[u32; 3]>,
+    /// The number of the first triangle held (0 in an ordinary read).
+    held_from: usize,
+    /// Where a streaming read's triangles go (an ordinary read keeps its own list,
+    /// which its corners' attributes index, and leaves this empty).
+    out: &'a mut Triangles<'s>,
+    /// In a streaming read, whether the current section's first triangles were handed
+    /// on, and what was known then.
+    flushed: Option<Flushed>,
+    /// Whether the current section's texture coordinates (normals) start with the
+    /// file's first as a stand-in, which no corner uses (see the module docs).
+    stand_in: [bool; 2],
     uv: Corners,
     normal: Corners,
     /// Lines counted by keyword (the old reader's scan counted these).
@@ -508,14 +553,18 @@ fn section_error(what: &str) -> ReadError {
 const POSITION: &str = "position parse error";
 const COLOUR: &str = "color parse error (too many or too few components)";
 
-impl Reader {
-    fn new() -> Self {
+impl<'a, 's> Reader<'a, 's> {
+    fn new(out: &'a mut Triangles<'s>) -> Self {
         Self {
             v: List::new(),
             vt: List::new(),
             vn: List::new(),
             colours: Vec::new(),
             triangles: Vec::new(),
+            held_from: 0,
+            out,
+            flushed: None,
+            stand_in: [false; 2],
             uv: Corners::default(),
             normal: Corners::default(),
             count: Counts::default(),
@@ -964,7 +1013,7 @@ impl Reader {
             let file = if i < 0 { count as i64 + i } else { i - 1 };
             u32::try_from(file).ok().filter(|&f| f < DUP)
         };
-        let first_in_section = self.triangles.len() == self.section_start;
+        let first_in_section = self.made() == self.section_start;
         let mut out = [[0u32; 3]; 0].to_vec();
         out.reserve(corners.len());
         for (c, corner) in corners.iter().enumerate() {
@@ -987,6 +1036,7 @@ impl Reader {
                 } else if c == 0 && first_in_section {
                     // The section's first value is the file's first (no corner uses it).
                     list.output(0);
+                    self.stand_in[kind - 1] = true;
                 }
             }
             out.push(slots);
@@ -1005,7 +1055,7 @@ impl Reader {
         let a = out[0];
         for pair in out[1..].windows(2) {
             let (b, c) = (pair[0], pair[1]);
-            let t = self.triangles.len();
+            let t = self.made();
             if t >= MAX_ELEMENTS {
                 return self.fail(ReadError::mesh(
                     None,
@@ -1016,10 +1066,62 @@ impl Reader {
                     },
                 ));
             }
+            let held = self.triangles.len();
             self.triangles.push([a[0], b[0], c[0]]);
-            self.uv.push(t, [a[1], b[1], c[1]]);
-            self.normal.push(t, [a[2], b[2], c[2]]);
+            self.uv.push(held, [a[1], b[1], c[1]]);
+            self.normal.push(held, [a[2], b[2], c[2]]);
         }
+        if self.out.is_streamed() && self.all_read() {
+            self.flush();
+        }
+    }
+
+    /// Whether every element the section's corners named so far is read: then
+    /// nothing held can matter to the section's error any more but through
+    /// [`Flushed`]. (The stand-in first value of a section without texture coordinates
+    /// or normals may be missing: it is never the one an error names, see
+    /// [`first_out_of_bounds`](Self::first_out_of_bounds), which starts after it.)
+    fn all_read(&self) -> bool {
+        let only_stand_in = |list: &List<f32>, stand_in: bool| {
+            list.forward.is_empty()
+                || (stand_in && list.forward.len() == 1 && list.forward.contains_key(&0))
+        };
+        self.v.forward.is_empty()
+            && only_stand_in(&self.vt, self.stand_in[0])
+            && only_stand_in(&self.vn, self.stand_in[1])
+    }
+
+    /// Triangles made so far (while building).
+    fn made(&self) -> usize {
+        self.held_from + self.triangles.len()
+    }
+
+    /// Hands the held triangles on (a streaming read), each vertex as its file
+    /// element's position, once every vertex they name is read, and notes what
+    /// [`first_out_of_bounds`](Self::first_out_of_bounds) needs to know of those of the
+    /// current section.
+    ///
+    /// Why a streaming read may let them go: the section's error, if its end finds an
+    /// element missing, is decided by the first new element in its corners whose file
+    /// element is missing (or, for a vertex, its colour). Those handed on named only
+    /// elements already read, so of them only a missing colour can decide it, which
+    /// the largest vertex among them tells.
+    fn flush(&mut self) {
+        if self.triangles.is_empty() {
+            return;
+        }
+        for &t in &self.triangles {
+            let file = t.map(|o| self.v.file_element(o));
+            self.out.push(file, &self.v.file);
+        }
+        self.held_from += self.triangles.len();
+        self.triangles.clear();
+        self.uv.corners.clear();
+        self.normal.corners.clear();
+        self.flushed = Some(Flushed {
+            next: [&self.v.src, &self.vt.src, &self.vn.src].map(|src| src.len() as u32),
+            max_vertex: self.v.max_new,
+        });
     }
 
     /// Ends the current section: every element its faces named must be in the file by
@@ -1048,22 +1150,29 @@ impl Reader {
             }
         }
         self.v.commit();
+        let section_held = self.section_start.saturating_sub(self.held_from);
         for (list, corners) in [
             (&mut self.vt, &mut self.uv),
             (&mut self.vn, &mut self.normal),
         ] {
-            if list.len == 0 {
-                list.discard();
-                corners.clear_from(self.section_start);
-            } else {
+            let kept = list.len > 0;
+            if kept {
                 list.commit();
+            } else {
+                list.discard();
             }
+            corners.end_section(kept, section_held);
         }
         // Indices within their list by now can never be past the file's end.
         for (kind, far) in self.far.iter_mut().enumerate() {
             far.drop_within(self.count.of(kind) as u64);
         }
-        self.section_start = self.triangles.len();
+        if self.out.is_streamed() {
+            self.flush();
+        }
+        self.flushed = None;
+        self.stand_in = [false; 2];
+        self.section_start = self.made();
     }
 
     /// Which list the first corner of the section that names an element missing at
@@ -1071,18 +1180,27 @@ impl Reader {
     /// vertex (and its colour), then its texture coordinate, then its normal.
     fn first_out_of_bounds(&self) -> &'static str {
         let mut next = [self.v.base, self.vt.base, self.vn.base];
-        // A section whose first corner has no `vt` (`vn`) made the file's first value
-        // its first, before any corner's.
-        for (kind, corners, list) in [(1, &self.uv, &self.vt), (2, &self.normal, &self.vn)] {
-            let first = corners
-                .corners
-                .get(self.section_start)
-                .map_or(Channel::MISSING, |c| c[0]);
-            if first == Channel::MISSING && list.src.len() > list.base as usize {
-                next[kind] += 1;
+        if let Some(flushed) = self.flushed {
+            // The section's first triangles were handed on (see `flush`).
+            if !self.colours.is_empty() && 3 * flushed.max_vertex as usize + 2 >= self.colours.len()
+            {
+                return "vertex color";
+            }
+            next = flushed.next;
+        } else {
+            // A section whose first corner has no `vt` (`vn`) made the file's first
+            // value its first, before any corner's.
+            for (kind, corners, list) in [(1, &self.uv, &self.vt), (2, &self.normal, &self.vn)] {
+                let first = corners
+                    .corners
+                    .get(self.section_start - self.held_from)
+                    .map_or(Channel::MISSING, |c| c[0]);
+                if first == Channel::MISSING && list.src.len() > list.base as usize {
+                    next[kind] += 1;
+                }
             }
         }
-        for t in self.section_start..self.triangles.len() {
+        for t in self.section_start.max(self.held_from) - self.held_from..self.triangles.len() {
             for k in 0..3 {
                 let corner = [
                     Some(self.triangles[t][k]),
@@ -1165,7 +1283,33 @@ impl Reader {
             .map_or(failure, |(_, e)| e)
     }
 
-    /// The mesh, once every line is read and nothing stopped building.
+    /// What [`Attributes::names`](crate::attributes::Attributes::names) says of the
+    /// mesh [`finish`](Self::finish) makes in an ordinary read (before it).
+    fn attribute_names(&self) -> Vec<String> {
+        let mut kept = Attributes::default();
+        let coloured = self.coloured.0 > 0 && self.coloured.1 == 0;
+        for (kind, there) in [
+            (ChannelKind::TexCoord, self.uv.kept_values),
+            (ChannelKind::Normal, self.normal.kept_values),
+            (ChannelKind::Color, coloured),
+        ] {
+            if there {
+                kept.channels
+                    .push(Channel::new(kind, Vec::new(), Vec::new()));
+            }
+        }
+        // Each kind of label has one face at least (a mesh has a triangle) when it has
+        // a run.
+        let one = |runs: &[LabelRun]| expand_runs(runs, 1);
+        kept.groups.faces = one(&self.group_runs);
+        kept.materials.faces = one(&self.material_runs);
+        kept.material_libraries = self.names.libraries.clone();
+        kept.names()
+    }
+
+    /// The mesh, once every line is read and nothing stopped building. A streaming
+    /// read's has no triangles (they were handed on), so neither per-corner nor
+    /// per-face values.
     fn finish(&mut self) -> IndexedMesh {
         let triangles = std::mem::take(&mut self.triangles);
         let t = triangles.len();
@@ -1206,10 +1350,10 @@ impl Reader {
                 3,
             ),
         ] {
-            let mut corners = corners.corners;
-            if !corners.iter().flatten().any(|&i| i != Channel::MISSING) {
+            if !corners.kept_values {
                 continue;
             }
+            let mut corners = corners.corners;
             corners.resize(t, [Channel::MISSING; 3]);
             list.map = Vec::new();
             let mut values = std::mem::take(&mut list.file);
@@ -1444,12 +1588,24 @@ fn not_obj(other: &'static str) -> ReadError {
     ReadError::not_this_format(Format::Obj, Some(other), "the content is not OBJ text")
 }
 
-pub(crate) fn read(input: &mut Input<'_>, notes: &mut ReadNotes) -> Result<IndexedMesh, ReadError> {
+/// Reads an OBJ file. An ordinary read (`triangles` keeping its list) returns the
+/// whole mesh and leaves `triangles` empty. A streaming read hands each triangle to
+/// `triangles` once the vertices it names are read, and returns the mesh without
+/// triangles, with the names of what the file carries besides positions (which the
+/// mesh, without its per-face labels, cannot show).
+pub(crate) fn read(
+    input: &mut Input<'_>,
+    notes: &mut ReadNotes,
+    triangles: &mut Triangles<'_>,
+) -> Result<(IndexedMesh, Option<Vec<String>>), ReadError> {
     let mut solid_pending = sniff(input)?;
     let mut stream = TextStream::new(input, 1);
     let mut lines = Logical { joined: Vec::new() };
-    let mut r = Reader::new();
+    let mut r = Reader::new(triangles);
     while let Some((no, span)) = lines.next(&mut stream)? {
+        if r.out.has_failed() {
+            return Err(Triangles::stopped());
+        }
         let seen = stream.offset();
         let line = match &span {
             Some(span) => stream.span(span.clone()),
@@ -1485,14 +1641,27 @@ pub(crate) fn read(input: &mut Input<'_>, notes: &mut ReadNotes) -> Result<Index
         let failure = r.failure.take().unwrap_or_else(rejected);
         return Err(r.second_pass(failure));
     }
+    if r.out.has_failed() {
+        return Err(Triangles::stopped());
+    }
+    let streamed = r.out.is_streamed();
+    let names = streamed.then(|| r.attribute_names());
     let mesh = r.finish();
-    if let Err(e) = mesh.validate() {
+    let checked = if streamed {
+        // `validate`'s checks in its order, on the mesh without its triangles (the
+        // corners, handed on, named vertices in range by construction).
+        check_vertices(&mesh.positions, 0, r.out.len())
+            .and_then(|()| mesh.attributes.validate(0).map_err(InputError::Attributes))
+    } else {
+        mesh.validate()
+    };
+    if let Err(e) = checked {
         // Say where, when the check of the numbers can (e.g. a non-finite coordinate).
         return Err(r.second_pass(ReadError::mesh(None, e)));
     }
     notes.skipped_lines += r.notes.skipped_lines;
     notes.non_utf8_lines += r.notes.non_utf8_lines;
-    Ok(mesh)
+    Ok((mesh, names))
 }
 
 /// A refusal with nothing more to say (not reached: every path that stops reading
@@ -1929,6 +2098,82 @@ mod tests {
         // Both outcomes are well represented.
         assert!(kinds.get("ok").copied().unwrap_or(0) > 2_000, "{kinds:?}");
         assert!(kinds.len() > 10, "{kinds:?}");
+    }
+
+    /// A streaming read fails as the ordinary read does, with the same message, or
+    /// hands on its triangles, on random files (sections, elements named before they
+    /// are read, every kind of problem) and on files where a section's first triangles
+    /// were handed on before its end found an element missing.
+    #[test]
+    fn random_files_stream_as_they_read() {
+        use crate::io::input::tests::check;
+        let mut rng = Rng(0x51ed_270b_2f6c_11a3);
+        for case in 0..3_000 {
+            let lines = 1 + rng.below(40) as usize;
+            let data = random_obj(&mut rng, lines);
+            for chunk in [3, 4096] {
+                check(&data, Format::Obj, chunk, true, &format!("case {case}"));
+            }
+        }
+        let tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+        let cases = [
+            // Handed on, then a later face of the section names a vertex never read.
+            format!("{tri}f 1 2 3\nf 1 2 9\n"),
+            // ... a texture coordinate never read (the file has some).
+            format!("vt 0 0\n{tri}f 1/1 2/1 3/1\nf 1/1 2/1 3/7\n"),
+            // ... a colour missing for a vertex handed on, the colours read later.
+            format!("{tri}f 1 2 3\nv 0 0 1 1 0 0\nf 1 2 4\n"),
+            // ... or for a vertex named after the hand-on only.
+            "v 0 0 0 1 0 0\nv 1 0 0 1 0 0\nv 0 1 0 1 0 0\nf 1 2 3\nv 1 1 1\nf 1 2 4\n".to_string(),
+            // A face before its vertices waits for them; then one that never comes.
+            format!("f 1 2 3\n{tri}f 1 2 3\ng b\nf 4 5 6\n{tri}"),
+            format!("f 1 2 3\n{tri}g b\nf 1 2 3\nf 1 2 3/1\n"),
+            // Sections, labels, texture coordinates and normals, all read.
+            format!("mtllib m.mtl\nvt 0 0\nvn 0 0 1\n{tri}usemtl a\nf 1/1/1 2/1/1 3/1/1\ng x\nf 3//1 2//1 1//1\n"),
+        ];
+        for data in &cases {
+            for chunk in [1, 4096] {
+                check(data.as_bytes(), Format::Obj, chunk, true, data);
+            }
+        }
+    }
+
+    /// A streaming read hands a triangle on as soon as the vertices it names are read,
+    /// not at its section's end: before a later line turns out bad, the sink has it
+    /// (with texture coordinates, normals and groups in the file or not). A triangle
+    /// that names a vertex not read yet waits for it, and the ones after it too (until
+    /// a face is read after it).
+    #[test]
+    fn triangles_are_handed_on_once_their_vertices_are_read() {
+        #[derive(Default)]
+        struct Count(usize);
+        impl crate::io::TriangleSink for Count {
+            fn triangle(&mut self, _: [[f64; 3]; 3]) -> Result<(), crate::io::IoError> {
+                self.0 += 1;
+                Ok(())
+            }
+        }
+        let tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+        let bad = "f 1 2 x\n";
+        for (data, handed_on) in [
+            (format!("{tri}f 1 2 3\nf 3 2 1\n{bad}"), 2),
+            (format!("g a\n{tri}f 1 2 3\ng b\nf 3 2 1\n{bad}"), 2),
+            (
+                format!("vt 0 0\nvn 0 0 1\n{tri}f 1/1/1 2/1/1 3//1\n{bad}"),
+                1,
+            ),
+            (format!("vt 0 0\n{tri}f 1 2 3\nf 1/1 2/1 3/1\n{bad}"), 2),
+            (format!("{tri}f 1 2 3\nf 1 2 4\nf 3 2 1\n{bad}"), 1),
+            (
+                format!("{tri}f 1 2 3\nf 1 2 4\nf 3 2 1\nv 1 1 0\nf 1 2 3\n{bad}"),
+                4,
+            ),
+        ] {
+            let mut sink = Count::default();
+            let streamed = crate::io::stream_bytes(data.as_bytes(), Format::Obj, &mut sink);
+            assert!(streamed.is_err(), "{data:?}");
+            assert_eq!(sink.0, handed_on, "{data:?}");
+        }
     }
 
     /// Problems whose report depends on more than their line, each as the old reader

@@ -7,8 +7,11 @@
 //! streaming read still holds: PLY and OFF keep their vertices (24 bytes each, the
 //! faces name them by number); STL keeps only the facet being read. Attribute values
 //! (per vertex, per face) are read and checked as by an ordinary read, but only the
-//! record being read is kept. OBJ and glTF are not streamed yet: they are read whole,
-//! as an ordinary read reads them, and their triangles handed on afterwards.
+//! record being read is kept. OBJ keeps its vertices, texture coordinates and normals
+//! (and, per vertex its faces use, where it went: see `io::obj`), but no triangle once
+//! the vertices it names are read, nor any per-corner or per-face value. glTF is not
+//! streamed: it is read whole, as an ordinary read reads it, and its triangles handed
+//! on afterwards.
 //!
 //! A triangle whose corners are not all known when it is read (a PLY file with its
 //! faces before its vertices) waits, 16 bytes a triangle, until the end of the file.
@@ -34,7 +37,8 @@ use crate::input::{check_vertices, InputError};
 pub trait TriangleSink {
     /// Takes one triangle, as its three corners' positions (in the file's corner
     /// order). An error stops the read (at the reader's next record for PLY, OFF and
-    /// STL; OBJ and glTF are read whole first): it is what the read returns.
+    /// STL, at its next line for OBJ; glTF is read whole first): it is what the read
+    /// returns.
     fn triangle(&mut self, corners: [[f64; 3]; 3]) -> Result<(), IoError>;
 }
 

@@ -40,8 +40,8 @@
 //! Nothing here holds the tiles together in memory except [`merge`], which holds the
 //! simplified mesh it writes. [`split`] streams its input to disk as it reads it and
 //! builds the tiles from there one at a time (`tiles::split`): it holds the input's
-//! vertices while reading (PLY, OFF and OBJ; STL none; OBJ and glTF are still read
-//! whole), then one tile.
+//! vertices while reading (PLY, OFF and OBJ; STL none; glTF is read whole), then one
+//! tile.
 //!
 //! Errors are [`TilesError`]s that name the file; those a later step fixes say which
 //! ([`TilesError::remedy`]), for the caller to word in its own terms (a command line,

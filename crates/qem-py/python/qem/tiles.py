@@ -153,8 +153,8 @@ def split(
 ) -> Manifest:
     """Cuts the mesh file ``input`` (any format :func:`qem.load` reads) into spatial
     tiles in ``directory`` (created if missing), and returns the manifest. The file is
-    streamed to a temporary directory inside ``directory`` as it is read (PLY, OFF and
-    STL without holding their triangles; OBJ and glTF are read whole first).
+    streamed to a temporary directory inside ``directory`` as it is read (PLY, OFF, STL
+    and OBJ without holding their triangles; glTF is read whole first).
 
     ``tile_triangles``: at most this many triangles per tile (default 1,000,000: a
     tile's simplification then takes about 200 MB); or ``tiles``: this many tiles, of
