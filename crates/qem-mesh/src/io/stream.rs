@@ -8,7 +8,7 @@
 //! faces name them by number); STL keeps only the facet being read. Attribute values
 //! (per vertex, per face) are read and checked as by an ordinary read, but only the
 //! record being read is kept. OBJ keeps its vertices, texture coordinates and normals
-//! (and, per vertex its faces use, where it went: see `io::obj`), but no triangle once
+//! (and, for each, the output element it became: see `io::obj`), but no triangle once
 //! the vertices it names are read, nor any per-corner or per-face value. glTF is not
 //! streamed: it is read whole, as an ordinary read reads it, and its triangles handed
 //! on afterwards.
@@ -314,7 +314,7 @@ mod tests {
             read_bytes(off, Format::Off).is_err(),
             "the third face is malformed"
         );
-        for format in [Format::Off, Format::Stl, Format::Ply] {
+        for format in [Format::Off, Format::Stl, Format::Ply, Format::Obj] {
             let data = match format {
                 Format::Off => off.to_vec(),
                 _ => {
