@@ -3,7 +3,7 @@
 //! plane (exact quadrics' bookkeeping, [`super::pass_exact`]).
 //!
 //! Two ways to give them, the same bits either way:
-//! - **kept**, one [`Facing`] (12 bytes) and, with exact quadrics, one
+//! - **kept**, one [`Facing`] (4 bytes) and, with exact quadrics, one
 //!   [`WeightedPlane`] (40 bytes) per triangle, computed at the setup;
 //! - **read from the orientation check's index**, when the check is on: the index
 //!   holds every input triangle's corners in the loop's frame (the very points the

@@ -164,7 +164,7 @@ impl<'a> Positions<'a> {
                 fixed.settings,
                 old,
                 new,
-                || fixed.input_faces.facing(x.triangle).normal(),
+                || fixed.input_faces.facing(x.triangle).direction(),
                 || {
                     cross_underflows(corners.map(|c| {
                         if c == a || c == b {
