@@ -22,8 +22,9 @@ use qem_core::{DVec3, Frame};
 pub(super) struct Facing([i16; 2]);
 
 impl Facing {
-    /// The facing of a triangle without area (it points nowhere).
-    const NONE: Facing = Facing([i16::MIN, i16::MIN]);
+    /// The facing of a triangle without area (it points nowhere), or of one the run
+    /// never asks about.
+    pub const NONE: Facing = Facing([i16::MIN, i16::MIN]);
 
     /// Octahedral coordinates in `[-1, 1]` are kept in steps of `1 / STEPS`.
     const STEPS: f64 = i16::MAX as f64;
@@ -62,13 +63,6 @@ impl Facing {
         } else {
             DVec3::new((1.0 - v.abs()).copysign(u), (1.0 - u.abs()).copysign(v), z)
         }
-    }
-}
-
-impl Default for Facing {
-    /// A triangle without area's.
-    fn default() -> Facing {
-        Facing::NONE
     }
 }
 
@@ -224,7 +218,6 @@ mod tests {
         ] {
             assert_eq!(Facing::of(normal).direction(), DVec3::ZERO);
         }
-        assert_eq!(Facing::default().direction(), DVec3::ZERO);
     }
 
     /// `turned_past` against the angle computed with `acos`.

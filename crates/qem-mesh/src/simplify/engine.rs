@@ -576,7 +576,7 @@ impl Engine {
             .into_par_iter()
             .map(|t| {
                 if skipped(t) {
-                    return Facing::default();
+                    return Facing::NONE;
                 }
                 let [pa, pb, pc] = corners(t);
                 Facing::of((pb - pa).cross(pc - pa))

@@ -186,11 +186,7 @@ mod tests {
     #[test]
     fn segments_follow_merges_and_vanish_when_their_ends_meet() {
         let mut e = PassExact::new(6, 2);
-        let faces = InputFaces::kept(
-            vec![Facing::default(); 2],
-            vec![plane(1.0), plane(2.0)],
-            None,
-        );
+        let faces = InputFaces::kept(vec![Facing::NONE; 2], vec![plane(1.0), plane(2.0)], None);
         let face = |t| faces.quadric(t);
         let border = Quadric::from_plane(DVec3::X, -3.0);
         e.add_border_plane(4, 5, border);
