@@ -91,7 +91,7 @@ class CleanOptions(TypedDict, total=False):
 class Relaxation(TypedDict):
     """A step of the ladder of relaxations that a run climbed."""
 
-    step: Literal["fold_over", "border_loops", "merged_faces"]
+    step: Literal["fold_over", "border_loops", "merged_faces", "flipped_faces"]
     contractions: int
     """Contractions made while the step was in force."""
 
