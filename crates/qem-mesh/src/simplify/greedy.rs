@@ -105,7 +105,14 @@ impl Engine {
                 if [a, b] == GONE {
                     continue;
                 }
-                greedy.queue.push(id, ranked(self.place(a, b).0.cost));
+                let cost = ranked(self.place(a, b).0.cost);
+                // A waived pair keeps its penalty, as a pass would cost it.
+                let cost = if self.waivers.contains(a, b) {
+                    penalised(cost, &self.merged_quadric(a, b))
+                } else {
+                    cost
+                };
+                greedy.queue.push(id, cost);
             }
         }
         self.greedy = greedy;
@@ -212,6 +219,53 @@ impl Engine {
         }
         for (n, plane) in exact.segments_at(&self.input_faces, v) {
             add(n, plane);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::speculation_tests::thin_lens;
+    use super::*;
+    use crate::simplify::observer::NoObserver;
+    use crate::simplify::ContractionOrder;
+
+    /// When the ladder asks every pair again, a waived pair is queued at the waivers'
+    /// penalty, as a pass would cost it: at its plain cost it would come up among the
+    /// first and be contracted without the orientation check at once.
+    #[test]
+    fn pairs_queued_again_keep_the_waivers_penalty() {
+        let mesh = thin_lens(12, 24);
+        let frame = Frame::from_points(mesh.positions.iter().map(|p| DVec3::from_array(*p)));
+        let options = SimplifyOptions::default().with_order(ContractionOrder::Greedy);
+        let mut engine = Engine::new(&mesh, frame, &[], &options, None);
+        // A target of every live triangle: the pairs are queued, none is contracted.
+        let live = engine.live.len();
+        engine.run_greedy(live, &mut NoObserver);
+        assert!(engine.greedy.filled);
+        let waived: Vec<[u32; 2]> = (0..engine.greedy.pairs.len() as u32)
+            .step_by(5)
+            .map(|id| engine.greedy.pairs.ends(id))
+            .filter(|&ends| ends != GONE)
+            .collect();
+        assert!(waived.len() > 10);
+        for &[a, b] in &waived {
+            engine.waivers.waive(a, b);
+        }
+        engine.requeue_every_pair();
+        let mut queued = Vec::new();
+        while let Some((id, cost)) = engine.greedy.queue.pop() {
+            queued.push((engine.greedy.pairs.ends(id), cost));
+        }
+        assert_eq!(queued.len(), engine.greedy.pairs.len());
+        for ([a, b], cost) in queued {
+            let plain = ranked(engine.place(a, b).0.cost);
+            let expected = if waived.contains(&[a, b]) {
+                penalised(plain, &engine.merged_quadric(a, b))
+            } else {
+                plain
+            };
+            assert_eq!(cost.to_bits(), expected.to_bits(), "pair {a} {b}");
         }
     }
 }
