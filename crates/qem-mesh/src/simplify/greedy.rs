@@ -55,7 +55,7 @@ impl Engine {
                 // are allowed) depends on its neighbours' triangles, which a
                 // contraction elsewhere can change without costing the pair again: it
                 // is costed again here, and queued again if it went up.
-                let fresh = ranked(self.place(a, b).0.cost);
+                let fresh = self.queue_cost(a, b);
                 if fresh > cost {
                     greedy.queue.push(id, fresh);
                     continue;
@@ -94,9 +94,10 @@ impl Engine {
         reason
     }
 
-    /// Queues again, at its current cost, every pair that is not gone: those a check
-    /// refused left the queue (see the module's doc), and the ladder of relaxations
-    /// ([`super::super::ladder`]) asks them again under other checks.
+    /// Queues again, at its current cost (a waived pair at the penalty), every pair
+    /// that is not gone: those a check refused left the queue (see the module's doc),
+    /// and the ladder of relaxations ([`super::super::ladder`]) asks them again under
+    /// other checks.
     pub(crate) fn requeue_every_pair(&mut self) {
         let mut greedy = std::mem::take(&mut self.greedy);
         if greedy.filled {
@@ -105,17 +106,21 @@ impl Engine {
                 if [a, b] == GONE {
                     continue;
                 }
-                let cost = ranked(self.place(a, b).0.cost);
-                // A waived pair keeps its penalty, as a pass would cost it.
-                let cost = if self.waivers.contains(a, b) {
-                    penalised(cost, &self.merged_quadric(a, b))
-                } else {
-                    cost
-                };
-                greedy.queue.push(id, cost);
+                greedy.queue.push(id, self.queue_cost(a, b));
             }
         }
         self.greedy = greedy;
+    }
+
+    /// The cost the pair `a b` is queued at now: its cost, and a waived pair's at the
+    /// waivers' penalty, as a pass would rank it.
+    fn queue_cost(&self, a: u32, b: u32) -> f64 {
+        let cost = ranked(self.place(a, b).0.cost);
+        if self.waivers.contains(a, b) {
+            penalised(cost, &self.merged_quadric(a, b))
+        } else {
+            cost
+        }
     }
 
     /// Lists and costs every pair (as a pass does) and queues it.
@@ -231,8 +236,8 @@ mod tests {
     use crate::simplify::ContractionOrder;
 
     /// When the ladder asks every pair again, a waived pair is queued at the waivers'
-    /// penalty, as a pass would cost it: at its plain cost it would come up among the
-    /// first and be contracted without the orientation check at once.
+    /// penalty, as a pass would cost it: at its plain cost it would come up ahead of
+    /// its penalised rank and be contracted without the orientation check.
     #[test]
     fn pairs_queued_again_keep_the_waivers_penalty() {
         let mesh = thin_lens(12, 24);
