@@ -137,6 +137,9 @@ struct MeasureJson<'a> {
     diagonal: f64,
     triangles_a: usize,
     triangles_b: usize,
+    /// B's faces facing away from A's nearest triangle, and their share of B's area.
+    faces_facing_away: u64,
+    facing_away_area: f64,
     seed: u64,
     /// Per channel both meshes carry (by name): the difference between B's value and
     /// A's at the closest point, at B's face samples (UV units; degrees for normals).
@@ -201,6 +204,8 @@ pub fn run(args: &MeasureArgs) -> Result<(), String> {
             diagonal: m.diagonal,
             triangles_a: a.triangle_count(),
             triangles_b: b.triangle_count(),
+            faces_facing_away: m.faces_facing_away,
+            facing_away_area: m.facing_away_area,
             seed: args.seed,
             attributes: channels
                 .iter()
@@ -248,6 +253,11 @@ fn human(
     s += &format!("mean B→A:       {}\n", pct(m.mean_ba));
     s += &format!("RMS A→B:        {}\n", pct(m.rms_ab));
     s += &format!("RMS B→A:        {}\n", pct(m.rms_ba));
+    s += &format!(
+        "facing away:    {} faces of B ({:.4} % of its area)\n",
+        m.faces_facing_away,
+        100.0 * m.facing_away_area
+    );
     s += &format!(
         "samples:        {} on A, {} on B (seed {})\n",
         m.samples_ab, m.samples_ba, args.seed

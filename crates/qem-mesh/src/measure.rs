@@ -117,6 +117,14 @@ pub struct Measurement {
     pub samples_ba: u64,
     /// The diagonal of `a`'s bounding box in model units (the unit of every figure).
     pub diagonal: f64,
+    /// The faces of `b` facing away from `a`: the faces whose normal makes a negative
+    /// dot product with the normal of `a`'s triangle nearest to the face's centroid
+    /// (with any of them, when several are equally near). What Metro-style tools count
+    /// as flipped faces after a simplification, and what the simplifier's orientation
+    /// check refuses to make. Faces of zero area (no normal) are not counted.
+    pub faces_facing_away: u64,
+    /// Their share of `b`'s area (0 to 1).
+    pub facing_away_area: f64,
 }
 
 /// Which of the two meshes an error is about.
@@ -180,6 +188,7 @@ pub fn measure(
     // even when the meshes are identical.
     let ab = directed(a, &index_b, options, stream_seed(options.seed, 0));
     let ba = directed(b, &index_a, options, stream_seed(options.seed, 1));
+    let away = facing_away(b, &index_a);
     Ok(Measurement {
         hausdorff: ab.max.max(ba.max) / diagonal,
         hausdorff_ab: ab.max / diagonal,
@@ -191,7 +200,67 @@ pub fn measure(
         samples_ab: ab.count,
         samples_ba: ba.count,
         diagonal,
+        faces_facing_away: away.faces,
+        facing_away_area: away.area_fraction(),
     })
+}
+
+/// The faces of one mesh facing away from another's surface, and their area.
+#[derive(Clone, Copy, Debug, Default)]
+struct FacingAway {
+    faces: u64,
+    /// Twice the area of those faces, and of all faces.
+    double_area: f64,
+    total_double_area: f64,
+}
+
+impl FacingAway {
+    fn area_fraction(&self) -> f64 {
+        if self.total_double_area > 0.0 {
+            self.double_area / self.total_double_area
+        } else {
+            0.0
+        }
+    }
+}
+
+/// How many triangles, at most, are asked when several of `to`'s triangles are equally
+/// near a centroid (a vertex where many triangles meet).
+const EQUALLY_NEAR_MAX: usize = 16;
+
+/// The faces of `from` facing away from `to` (see
+/// [`Measurement::faces_facing_away`]), on the thread pool; the sums are taken in face
+/// order, so the figures do not depend on the threads.
+fn facing_away(from: &IndexedMesh, to: &TriangleBvh) -> FacingAway {
+    let corners = |t: &[u32; 3]| t.map(|v| from.positions[v as usize]);
+    let per_face: Vec<(bool, f64)> = from
+        .triangles
+        .par_iter()
+        .map_init(Vec::new, |nearest, t| {
+            let [a, b, c] = corners(t);
+            let normal = cross(sub(b, a), sub(c, a));
+            let double_area = length(normal);
+            if double_area.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+                return (false, 0.0);
+            }
+            let centroid = [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0);
+            to.nearest_triangles(centroid, 1.0, 0.0, EQUALLY_NEAR_MAX, nearest);
+            let away = nearest.iter().any(|&i| {
+                let [p, q, r] = to.corners(i);
+                dot(normal, cross(sub(q, p), sub(r, p))) < 0.0
+            });
+            (away, double_area)
+        })
+        .collect();
+    let mut sum = FacingAway::default();
+    for (away, double_area) in per_face {
+        sum.total_double_area += double_area;
+        if away {
+            sum.faces += 1;
+            sum.double_area += double_area;
+        }
+    }
+    sum
 }
 
 /// Checks both meshes ([`IndexedMesh::validate`]), naming the one that fails.

@@ -771,6 +771,8 @@ fn measurement_dict<'py>(py: Python<'py>, m: &Measurement) -> PyResult<Bound<'py
     d.set_item("hausdorff_ba", m.hausdorff_ba)?;
     d.set_item("mean_ab", m.mean_ab)?;
     d.set_item("mean_ba", m.mean_ba)?;
+    d.set_item("faces_facing_away", m.faces_facing_away)?;
+    d.set_item("facing_away_area", m.facing_away_area)?;
     d.set_item("rms_ab", m.rms_ab)?;
     d.set_item("rms_ba", m.rms_ba)?;
     d.set_item("samples_ab", m.samples_ab)?;
@@ -960,7 +962,9 @@ fn default_options(py: Python<'_>, fast: bool) -> PyResult<Bound<'_, PyDict>> {
 /// a, b: (vertices, faces) pairs, or objects with .vertices and .faces (a trimesh.Trimesh).
 /// Returns a dict: hausdorff (symmetric), hausdorff_ab, hausdorff_ba, mean_ab, mean_ba,
 /// rms_ab, rms_ba as fractions of a's bounding-box diagonal ("ab": samples on a,
-/// distances to b), samples_ab, samples_ba, and diagonal (a's, model units). The same
+/// distances to b), samples_ab, samples_ba, diagonal (a's, model units), and
+/// faces_facing_away and facing_away_area (b's faces whose normal points away from a's
+/// triangle nearest to their centroid, and their share of b's area). The same
 /// seed gives the same figures to the bit whatever the number of cores. The GIL is
 /// released during the work.
 #[pyfunction]

@@ -14,6 +14,17 @@ def test_measure_identical_meshes_is_zero(sphere):
     assert m["hausdorff"] == pytest.approx(0.0, abs=1e-12)
     assert m["mean_ab"] == pytest.approx(0.0, abs=1e-12)
     assert m["diagonal"] == pytest.approx(2 * np.sqrt(3), rel=1e-3)
+    assert m["faces_facing_away"] == 0 and m["facing_away_area"] == 0.0
+
+
+def test_measure_counts_faces_facing_away(sphere):
+    vertices, faces = sphere
+    reversed_faces = np.array(faces, copy=True)
+    # Faces of a middle row (the pole rows have zero-area faces, which are not counted).
+    reversed_faces[1000:1010] = reversed_faces[1000:1010, ::-1]
+    m = qem.measure(sphere, (vertices, reversed_faces), min_samples=10_000)
+    assert m["faces_facing_away"] == 10
+    assert 0.0 < m["facing_away_area"] < 1.0
 
 
 def test_measure_a_shifted_copy():

@@ -30,6 +30,8 @@ fn a_mesh_against_itself_measures_zero_and_against_its_simplification_more() {
         assert!((0.0..1e-12).contains(&v), "{key} = {v}");
     }
     assert!(same["samples_ab"].as_u64().unwrap() >= 20_000);
+    assert_eq!(same["faces_facing_away"], 0);
+    assert_eq!(same["facing_away_area"], 0.0);
 
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("spot-10.obj");

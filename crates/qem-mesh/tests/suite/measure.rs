@@ -472,3 +472,62 @@ proptest! {
         }
     }
 }
+
+/// Faces facing away are counted exactly: none for a mesh against itself, and each
+/// reversed face of B once, with its share of B's area.
+#[test]
+fn reversed_faces_are_counted_as_facing_away_with_their_area() {
+    let a = cube();
+    let same = measure(&a, &a, &small(1)).unwrap();
+    assert_eq!(same.faces_facing_away, 0);
+    assert_eq!(same.facing_away_area, 0.0);
+
+    let mut b = cube();
+    // Two faces of one side (1/6 of the area), and one of another side (1/12).
+    for t in [0, 1, 4] {
+        b.triangles[t].swap(1, 2);
+    }
+    let m = measure(&a, &b, &small(1)).unwrap();
+    assert_eq!(m.faces_facing_away, 3);
+    assert!(
+        (m.facing_away_area - 0.25).abs() < 1e-12,
+        "{}",
+        m.facing_away_area
+    );
+    // The distances do not see the orientation.
+    assert_eq!(m.hausdorff, same.hausdorff);
+}
+
+/// The count asks A's triangle nearest to each face's centroid, not the one it came
+/// from: a face of B lying just under A's top sheet of a thin slab, facing down like
+/// the bottom sheet, faces away from A there.
+#[test]
+fn a_face_nearest_the_other_side_of_a_thin_part_faces_away() {
+    let top = grid(2, 0.1);
+    let mut bottom = grid(2, 0.0);
+    for t in &mut bottom.triangles {
+        t.swap(1, 2);
+    }
+    let n = top.positions.len() as u32;
+    let mut slab = top.clone();
+    slab.positions.extend(bottom.positions.iter().copied());
+    slab.triangles
+        .extend(bottom.triangles.iter().map(|t| t.map(|v| v + n)));
+    // B: one downward face at height 0.09, nearer the top sheet (0.01) than the bottom (0.09).
+    let b = IndexedMesh::new(
+        vec![[0.2, 0.2, 0.09], [0.3, 0.4, 0.09], [0.4, 0.2, 0.09]],
+        vec![[0, 1, 2]],
+    );
+    let m = measure(&slab, &b, &small(1)).unwrap();
+    assert_eq!(m.faces_facing_away, 1);
+    assert_eq!(m.facing_away_area, 1.0);
+    // Lowered to 0.04, nearer the bottom sheet: it agrees.
+    let mut lower = b.clone();
+    for p in &mut lower.positions {
+        p[2] = 0.04;
+    }
+    assert_eq!(
+        measure(&slab, &lower, &small(1)).unwrap().faces_facing_away,
+        0
+    );
+}

@@ -147,6 +147,11 @@ class Measurement(TypedDict):
     samples_ba: int
     diagonal: float
     """a's bounding-box diagonal in model units."""
+    faces_facing_away: int
+    """b's faces whose normal points away from a's triangle nearest to their centroid
+    (Metro-style tools count them as flipped)."""
+    facing_away_area: float
+    """Their share of b's area (0 to 1)."""
 
 def simplify(
     vertices: Vertices | Sequence[Sequence[float]],
