@@ -55,11 +55,13 @@ pub(crate) mod build;
 mod compact;
 mod contract;
 mod fan;
+mod flip;
 mod query;
 mod validate;
 
 pub use build::BuildStats;
 pub use contract::{ContractError, ContractLog, ContractOutcome};
+pub use flip::FlipError;
 use fan::{Fan, FanPool};
 pub use query::{EdgeClass, VertexClass};
 pub use validate::StoreError;
