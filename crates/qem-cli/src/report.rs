@@ -49,6 +49,8 @@ pub struct SimplifyJson {
     /// Output faces whose normal points away from their input face (0 unless the
     /// fold-over check is off).
     faces_flipped: usize,
+    /// Faces facing away from the input turned back by an edge flip after the run.
+    faces_turned_back: usize,
     /// What the reader passed over (issue 33): `skipped_lines`, `skipped_properties`,
     /// `skipped_primitives`, `non_utf8_lines`, `byte_order_mark`.
     read_notes: ReadNotesJson,
@@ -293,6 +295,7 @@ impl SimplifyJson {
             stopped_by: r.stopped_by.map(|c| c.as_str()),
             locked_vertices: r.locked_vertices,
             faces_flipped: r.faces_flipped,
+            faces_turned_back: r.faces_turned_back,
             read_notes: notes.into(),
             attributes: AttributesJson::default(),
             material_files: MaterialFilesJson::default(),

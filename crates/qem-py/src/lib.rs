@@ -753,6 +753,7 @@ fn report_dict<'py>(
     d.set_item("stopped_by", r.stopped_by.map(|c| c.as_str()))?;
     d.set_item("locked_vertices", r.locked_vertices)?;
     d.set_item("faces_flipped", r.faces_flipped)?;
+    d.set_item("faces_turned_back", r.faces_turned_back)?;
     let t = &r.timings;
     let timings = PyDict::new(py);
     timings.set_item("simplify", ms(simplify))?;

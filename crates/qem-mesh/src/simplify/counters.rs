@@ -15,6 +15,8 @@ pub(super) struct Counters {
     pub max_error: f64,
     pub rejected: Refusals,
     pub locked_vertices: usize,
+    /// Faces facing away turned back by an edge flip after the run (`turn_back`).
+    pub faces_turned_back: usize,
 }
 
 impl Counters {

@@ -1190,6 +1190,8 @@ mod attempt;
 mod greedy;
 #[path = "passes.rs"]
 mod passes;
+#[path = "turn_back.rs"]
+mod turn_back;
 
 #[cfg(test)]
 #[path = "passes_speculation_tests.rs"]

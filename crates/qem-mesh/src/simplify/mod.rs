@@ -58,7 +58,7 @@ mod settings;
 mod waivers;
 mod wedges;
 
-pub use observer::{Contraction, NoObserver, Observer, Phase, Progress};
+pub use observer::{Contraction, EdgeFlip, NoObserver, Observer, Phase, Progress};
 pub use options::{
     AttributeWeights, BoundaryMode, ContractionOrder, Length, Method, PlacementMode, QuadricMode,
     SimplifyOptions, Target, VirtualPairs, Weighting, DEFAULT_BOUNDARY_WEIGHT,
@@ -339,7 +339,7 @@ fn levels_of(
     let mut results = Vec::with_capacity(levels.len());
     let mut quadrics = Vec::new();
     let mut stopped_short: Option<StopReason> = None;
-    for &level in levels {
+    for (level_number, &level) in levels.iter().enumerate() {
         let target_triangles = level.triangles_for(triangles_in);
         let clock = Instant::now();
         observer.phase(Phase::Contracting);
@@ -347,6 +347,11 @@ fn levels_of(
             Some(reason) => reason,
             None => engine.run_order_with_ladder(options, target_triangles, observer),
         };
+        // The greedy order keeps its pairs for the next level, and a flip changes
+        // edges: its flips wait for the last level.
+        if options.order == ContractionOrder::Passes || level_number + 1 == levels.len() {
+            engine.turn_back_faces(observer);
+        }
         if stop_reason != StopReason::TargetReached {
             stopped_short = Some(stop_reason);
         }
@@ -409,6 +414,7 @@ fn levels_of(
                 .then_some(engine.ladder.stopped_by.unwrap_or(Constraint::NoPairs)),
             locked_vertices: counters.locked_vertices,
             faces_flipped: engine.flipped_faces(),
+            faces_turned_back: counters.faces_turned_back,
             timings,
         };
         if let Some((origin, quadrics_of_raw)) = raw_quadrics {
@@ -479,6 +485,7 @@ fn cluster_levels(
             stopped_by: None,
             locked_vertices: 0,
             faces_flipped: 0,
+            faces_turned_back: 0,
             timings: Timings {
                 setup: r.search,
                 contract: r.build,

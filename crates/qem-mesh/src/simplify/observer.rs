@@ -91,6 +91,17 @@ pub struct Contraction {
     pub cost: f64,
 }
 
+/// An edge flip of the run's last step, as reported to [`Observer::flipped`]: the
+/// two faces on the edge `p q`, `p q r` and `q p s`, became `p s r` and `s q r`
+/// (see [`SimplifyReport::faces_turned_back`](super::SimplifyReport::faces_turned_back)).
+/// Vertices are named as in [`Contraction`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct EdgeFlip {
+    /// The edge's ends `p` and `q`, in the order the first face runs it.
+    pub edge: [u32; 2],
+}
+
 /// Receives progress and may cancel a run. Every method has a no-op default.
 pub trait Observer {
     /// Called every few thousand contractions, and once at the end.
@@ -115,6 +126,9 @@ pub trait Observer {
     /// Called after every contraction. Meant for tests and analysis tools: it is on the
     /// hot path, so keep it cheap.
     fn contracted(&mut self, _contraction: &Contraction) {}
+    /// Called after every edge flip of the run's last step (faces facing away turned
+    /// back; rare).
+    fn flipped(&mut self, _flip: &EdgeFlip) {}
     /// Whether [`contracted`](Self::contracted) does anything. An observer that
     /// returns `false` spares the pass-based order from keeping the contractions it
     /// makes on other threads until they can be reported in order. The default is

@@ -15,7 +15,7 @@
 //! small meshes.
 
 use super::checks::is_zero_area;
-use super::observer::{Contraction, Observer};
+use super::observer::{Contraction, EdgeFlip, Observer};
 use super::settings::Settings;
 use super::SimplifyOptions;
 use crate::store::{ContractLog, MeshStore, VertexKey};
@@ -154,6 +154,28 @@ impl Observer for StoreReplay {
                 self.keys = keys;
             }
             Err(e) => self.failure = Some(format!("the store refused the cleaned mesh: {e}")),
+        }
+    }
+
+    fn flipped(&mut self, flip: &EdgeFlip) {
+        if self.failure.is_some() {
+            return;
+        }
+        let Some(store) = &mut self.store else {
+            self.failure = Some("a flip before the cleaned mesh".to_string());
+            return;
+        };
+        let [p, q] = flip.edge;
+        let (Some(&kp), Some(&kq)) = (self.keys.get(p as usize), self.keys.get(q as usize)) else {
+            self.failure = Some(format!("flip of {p} {q}: no such vertex"));
+            return;
+        };
+        if let Err(e) = store.flip_edge(kp, kq) {
+            self.failure = Some(format!("flip of {p} {q}: the store refused it: {e}"));
+        } else if let Err(e) = store.validate() {
+            self.failure = Some(format!(
+                "flip of {p} {q}: the store is invalid after it: {e}"
+            ));
         }
     }
 

@@ -114,6 +114,10 @@ pub struct SimplifyReport {
     /// [`RelaxationStep::FlippedFaces`](super::RelaxationStep::FlippedFaces); it is a
     /// cheap self-check, not a comparison with the input surface.
     pub faces_flipped: usize,
+    /// Faces left facing away from the input by contractions made without the
+    /// orientation check, turned back by an edge flip after the run (the count and
+    /// every position stay; see [`SimplifyOptions::orientation_check`](super::SimplifyOptions::orientation_check)).
+    pub faces_turned_back: usize,
     /// Wall time per phase.
     pub timings: Timings,
 }

@@ -9,6 +9,10 @@
 //! bound, so reaches the point where the check would run; a waived pair that another
 //! check refuses keeps its waiver and its penalty.
 //!
+//! A contraction made without the check may leave a face facing away; the vertices
+//! such contractions kept are recorded, and after the run their faces are asked again
+//! (`turn_back`).
+//!
 //! Why a flag per vertex beside the map: every edge of every pass asks whether it is
 //! waived, and once a pair has been refused the map is never empty again; the flags,
 //! one byte per vertex, answer no without hashing for almost every edge. The map is
@@ -48,6 +52,9 @@ pub(super) struct Waivers {
     flagged: Vec<bool>,
     /// Each vertex's waived partners, both ways round.
     partners: HashMap<u32, SmallVec<[u32; 4]>>,
+    /// The vertices kept by contractions made without the check (a waiver taken):
+    /// only their faces can face away from the input (see `turn_back`).
+    kept_unchecked: Vec<u32>,
 }
 
 impl Waivers {
@@ -56,6 +63,7 @@ impl Waivers {
         Waivers {
             flagged: vec![false; vertex_count],
             partners: HashMap::new(),
+            kept_unchecked: Vec::new(),
         }
     }
 
@@ -89,15 +97,26 @@ impl Waivers {
         }
     }
 
-    /// Ends the waiver of the pair `a`, `b`; whether it was waived.
+    /// Ends the waiver of the pair `a`, `b`, contracted without the check (`b` into
+    /// `a`); whether it was waived.
     pub fn take(&mut self, a: u32, b: u32) -> bool {
         if !self.contains(a, b) {
             return false;
         }
+        self.kept_unchecked.push(a);
         for (v, w) in [(a, b), (b, a)] {
             self.drop_partner(v, w);
         }
         true
+    }
+
+    /// The vertices kept by contractions made without the check since the last call,
+    /// in increasing order, each once.
+    pub fn take_kept_unchecked(&mut self) -> Vec<u32> {
+        let mut kept = std::mem::take(&mut self.kept_unchecked);
+        kept.sort_unstable();
+        kept.dedup();
+        kept
     }
 
     /// Ends every waiver of `v` (it moved or was removed).

@@ -107,11 +107,19 @@ mod tests {
     #[test]
     fn a_square_is_cut_along_its_other_diagonal() {
         let mesh = IndexedMesh::new(
-            vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
+            vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [1.0, 1.0, 0.0],
+                [0.0, 1.0, 0.0],
+            ],
             vec![[0, 1, 2], [2, 3, 0]],
         );
         let (mut store, keys) = MeshStore::from_mesh(&mesh).unwrap();
-        assert_eq!(store.flip_edge(keys[0], keys[1]), Err(FlipError::NotTwoFaces));
+        assert_eq!(
+            store.flip_edge(keys[0], keys[1]),
+            Err(FlipError::NotTwoFaces)
+        );
         assert_eq!(store.flip_edge(keys[1], keys[3]), Err(FlipError::NoEdge));
         store.flip_edge(keys[2], keys[0]).unwrap();
         store.validate().unwrap();

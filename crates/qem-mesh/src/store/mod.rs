@@ -61,8 +61,8 @@ mod validate;
 
 pub use build::BuildStats;
 pub use contract::{ContractError, ContractLog, ContractOutcome};
-pub use flip::FlipError;
 use fan::{Fan, FanPool};
+pub use flip::FlipError;
 pub use query::{EdgeClass, VertexClass};
 pub use validate::StoreError;
 

@@ -109,3 +109,26 @@ fn corpus_scans_have_no_face_against_the_nearest_input_face_at_ratio_0_1() {
         );
     }
 }
+
+/// Faces left facing away by contractions made without the check are turned back by
+/// edge flips after the run: the count stays the target, and the radial-edge store,
+/// replaying the contractions and the flips, ends with the engine's triangles.
+/// (`tm_angle_block` at 0.1: 2 flips; `oscad_issue945e` at 0.1: 1; 2026-12-06.)
+#[test]
+fn faces_facing_away_are_turned_back_and_the_store_follows() {
+    let Some(dir) = corpus_dir() else {
+        return;
+    };
+    for name in ["tm_angle_block.obj", "oscad_issue945e.obj"] {
+        let Some(mesh) = corpus_mesh(&dir, name) else {
+            continue;
+        };
+        let options = SimplifyOptions::default().with_target(Target::Ratio(0.1));
+        let out = common::simplify_replayed(&mesh, &options).expect("simplifies");
+        let r = &out.report;
+        assert!(r.faces_turned_back > 0, "{name}");
+        assert_eq!(r.stop_reason, StopReason::TargetReached, "{name}");
+        assert_eq!(r.triangles_out, r.target_triangles, "{name}");
+        assert_valid(&out.mesh, mesh.triangle_count());
+    }
+}

@@ -129,6 +129,8 @@ class Report(TypedDict):
     """With stop_reason "no_valid_pair": what stopped the run; None otherwise."""
     locked_vertices: int
     faces_flipped: int
+    faces_turned_back: int
+    """Faces facing away from the input turned back by an edge flip after the run."""
     timings_ms: dict[str, float]
     """simplify (the whole library call), clean, setup, contract, compact."""
 
