@@ -54,6 +54,27 @@ pub struct StoreReplay {
 }
 
 impl StoreReplay {
+    /// The store's keys of the vertices `ends` for the step `what`, unless a failure
+    /// is recorded already; records one when the cleaned mesh never came or a vertex
+    /// is unknown.
+    fn keys_for(&mut self, what: &str, ends: [u32; 2]) -> Option<[VertexKey; 2]> {
+        if self.failure.is_some() {
+            return None;
+        }
+        let keys = ends.map(|v| self.keys.get(v as usize).copied());
+        match (&self.store, keys) {
+            (Some(_), [Some(x), Some(y)]) => Some([x, y]),
+            (None, _) => {
+                self.failure = Some(format!("{what} before the cleaned mesh"));
+                None
+            }
+            (Some(_), _) => {
+                self.failure = Some(format!("{what}: no such vertex"));
+                None
+            }
+        }
+    }
+
     /// The number of contractions replayed.
     pub fn contractions(&self) -> usize {
         self.contractions
@@ -158,40 +179,26 @@ impl Observer for StoreReplay {
     }
 
     fn flipped(&mut self, flip: &EdgeFlip) {
-        if self.failure.is_some() {
-            return;
-        }
-        let Some(store) = &mut self.store else {
-            self.failure = Some("a flip before the cleaned mesh".to_string());
-            return;
-        };
         let [p, q] = flip.edge;
-        let (Some(&kp), Some(&kq)) = (self.keys.get(p as usize), self.keys.get(q as usize)) else {
-            self.failure = Some(format!("flip of {p} {q}: no such vertex"));
+        let what = format!("flip of {p} {q}");
+        let (Some([kp, kq]), Some(store)) = (self.keys_for(&what, flip.edge), self.store.as_mut())
+        else {
             return;
         };
-        if let Err(e) = store.flip_edge(kp, kq) {
-            self.failure = Some(format!("flip of {p} {q}: the store refused it: {e}"));
-        } else if let Err(e) = store.validate() {
-            self.failure = Some(format!(
-                "flip of {p} {q}: the store is invalid after it: {e}"
-            ));
-        }
+        let failure = match store.flip_edge(kp, kq) {
+            Err(e) => Some(format!("{what}: the store refused it: {e}")),
+            Ok(()) => (store.validate().err())
+                .map(|e| format!("{what}: the store is invalid after it: {e}")),
+        };
+        self.failure = failure;
     }
 
     fn contracted(&mut self, c: &Contraction) {
-        if self.failure.is_some() {
-            return;
-        }
-        let Some(store) = &mut self.store else {
-            self.failure = Some("a contraction before the cleaned mesh".to_string());
-            return;
-        };
-        let (Some(&a), Some(&b)) = (
-            self.keys.get(c.kept as usize),
-            self.keys.get(c.removed as usize),
+        let what = format!("contraction {}", self.contractions);
+        let (Some([a, b]), Some(store)) = (
+            self.keys_for(&what, [c.kept, c.removed]),
+            self.store.as_mut(),
         ) else {
-            self.failure = Some(format!("contraction {}: no such vertex", self.contractions));
             return;
         };
         let step = self.contractions;
