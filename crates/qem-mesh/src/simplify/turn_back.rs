@@ -1,8 +1,8 @@
 //! The run's last step: faces facing away from the input, turned back by edge flips.
 //!
 //! Only a contraction made without the orientation check (a waived pair, see
-//! [`super::waivers`]) can leave a face facing away from the input surface nearest to
-//! its centroid; most such faces go in later contractions, but one made near the
+//! [`crate::simplify::waivers`]) can leave a face facing away from the input surface
+//! nearest to its centroid; most such faces go in later contractions, but one made near the
 //! target may stay. After the run, each face around a vertex that such a contraction
 //! kept is asked the check again, and one that faces away is turned back by flipping
 //! one of its edges, when a flip exists that leaves both faces of nonzero area, on the
