@@ -347,9 +347,10 @@ fn levels_of(
             Some(reason) => reason,
             None => engine.run_order_with_ladder(options, target_triangles, observer),
         };
-        // The greedy order keeps its pairs for the next level, and a flip changes
-        // edges: its flips wait for the last level.
-        if options.order == ContractionOrder::Passes || level_number + 1 == levels.len() {
+        // After the last level only: a later level's exact quadrics take a live
+        // triangle's input plane to belong to its corners, and the greedy order keeps
+        // its pairs from level to level; a flip changes both.
+        if level_number + 1 == levels.len() {
             engine.turn_back_faces(observer);
         }
         if stop_reason != StopReason::TargetReached {
