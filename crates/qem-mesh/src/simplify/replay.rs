@@ -1,5 +1,6 @@
-//! The engine's oracle: an [`Observer`] that replays every contraction of a run on the
-//! radial-edge store ([`MeshStore`]), the library's model of non-manifold input, and
+//! The engine's oracle: an [`Observer`] that replays every contraction of a run, and
+//! every edge flip of its last step ([`MeshStore::flip_edge`]), on the radial-edge
+//! store ([`MeshStore`]), the library's model of non-manifold input, and
 //! checks after every step that the store is valid and removed the triangles the
 //! engine removed, and at the end that both hold the same triangles.
 //!

@@ -99,11 +99,6 @@ impl Engine {
             if self.flip_passes(t, new_t, u, new_u) {
                 self.triangles[t as usize] = new_t;
                 self.triangles[u as usize] = new_u;
-                // Costs kept for reuse (a later level of detail) are stale around the
-                // flip: its corners count as moved in this pass.
-                for v in [p, q, r, s] {
-                    self.moved_in[v as usize] = self.pass;
-                }
                 // Rare (a few faces a run): the lists are made again.
                 self.list_incident_triangles();
                 return Some([p, q]);

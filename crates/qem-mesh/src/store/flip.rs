@@ -25,8 +25,8 @@ pub enum FlipError {
 impl MeshStore {
     /// Flips the edge `{p, q}` held by the faces `p q r` and `q p s`: they become
     /// `p s r` and `s q r` (the same orientation, the quad `p s q r` cut along `r s`
-    /// instead of `p q`). The edge `p q` goes, the edge `r s` is made. Positions and
-    /// every other face stay.
+    /// instead of `p q`). The edge record of `p q` becomes `r s` (its key now names
+    /// `r s`); the two faces keep their keys. Positions and every other face stay.
     pub fn flip_edge(&mut self, p: VertexKey, q: VertexKey) -> Result<(), FlipError> {
         if !(self.contains_vertex(p) && self.contains_vertex(q)) {
             return Err(FlipError::NoEdge);

@@ -21,7 +21,8 @@
 //! Submodules, one job each: `build` (from an [`IndexedMesh`](crate::IndexedMesh)),
 //! `query` (adjacency, links, classes, components), `contract` (edge and virtual-pair
 //! contraction), `validate` (the invariant check), `compact` (back to an
-//! [`IndexedMesh`](crate::IndexedMesh)), `fan` (the compact radial fan of an edge).
+//! [`IndexedMesh`](crate::IndexedMesh)), `fan` (the compact radial fan of an edge),
+//! `flip` (an edge flip, in place).
 //!
 //! Records hold other elements as 32-bit slot indices rather than 64-bit keys where the
 //! public API returns them by value (faces, edge endpoints; see `Packed`), and fans of up
